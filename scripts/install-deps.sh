@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs grainlab's build and test dependencies from Debian's packages.
+# Idempotent: does nothing (and needs no network) when everything is present.
+set -euo pipefail
+PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
+      libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev
+      python3 python3-numpy python3-matplotlib python3-pytest)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then exit 0; fi
+echo "install-deps: installing ${missing[*]}" >&2
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

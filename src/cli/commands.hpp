@@ -1,0 +1,27 @@
+#pragma once
+// The subcommands of the grainlab executable.
+#include <string>
+#include <vector>
+
+namespace grainlab::cli {
+
+struct RunOptions {
+  std::string config;
+  std::string outDir;
+  std::vector<std::string> overrides;
+  int threads = 0;  // 0: from the config
+  bool quiet = false;
+};
+// `grainlab run`: returns the exit code; throws InputError / SimulationError.
+int runLab(const RunOptions& options);
+
+struct BenchOptions {
+  std::string scene = "triaxial-iso";
+  int particles = 2000;
+  long steps = 2000;
+  int threads = 1;
+  bool json = false;
+};
+int runBench(const BenchOptions& options);
+
+}  // namespace grainlab::cli

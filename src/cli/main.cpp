@@ -1,0 +1,63 @@
+// The grainlab command line (INTERFACE.md). Exit codes: 0 success, 2 bad input, 1 failed run.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "cli/commands.hpp"
+#include "core/errors.hpp"
+#include "io/presets.hpp"
+
+int main(int argc, char** argv) {
+  using namespace grainlab;
+  CLI::App app{"grainlab — DEM engine and virtual soil laboratory (triaxial tests on virtual sand)"};
+  app.set_version_flag("--version", std::string("grainlab ") + GRAINLAB_VERSION);
+  app.require_subcommand(1);
+
+  cli::RunOptions run;
+  auto* runCmd = app.add_subcommand("run", "Run a laboratory test from a TOML config or preset:NAME");
+  runCmd->add_option("config", run.config, "CONFIG.toml or preset:NAME")->required();
+  runCmd->add_option("--out", run.outDir, "results folder (overrides output.dir)");
+  runCmd->add_option("--set", run.overrides, "override a config key: KEY=VALUE (TOML value)")
+      ->allow_extra_args(false);
+  runCmd->add_option("--threads", run.threads, "OpenMP threads (overrides solver.threads)")
+      ->check(CLI::PositiveNumber);
+  runCmd->add_flag("--quiet", run.quiet, "no progress output");
+
+  app.add_subcommand("presets", "List the shipped presets");
+
+  cli::BenchOptions bench;
+  auto* benchCmd = app.add_subcommand("bench", "Time a named scene (particle-steps per second)");
+  benchCmd->add_option("scene", bench.scene, "scene name (triaxial-iso)")->capture_default_str();
+  benchCmd->add_option("--particles", bench.particles, "number of particles")->capture_default_str();
+  benchCmd->add_option("--steps", bench.steps, "timed steps")->capture_default_str();
+  benchCmd->add_option("--threads", bench.threads, "OpenMP threads")->capture_default_str();
+  benchCmd->add_flag("--json", bench.json, "print one JSON object");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  try {
+    if (app.got_subcommand("presets")) {
+      for (const auto& p : io::presets()) fmt::print("{:<22} {}\n", p.name, p.description);
+      return 0;
+    }
+    if (app.got_subcommand("bench")) return cli::runBench(bench);
+    return cli::runLab(run);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "grainlab: %s\n", e.what());
+    return 2;
+  } catch (const SimulationError& e) {
+    std::fprintf(stderr, "grainlab: run failed: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "grainlab: error: %s\n", e.what());
+    return 1;
+  }
+}

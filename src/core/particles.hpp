@@ -1,0 +1,36 @@
+#pragma once
+// Particle storage as structure-of-arrays: the hot loops touch only the arrays they need.
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace grainlab {
+
+struct Particles {
+  // Kinematic state.
+  std::vector<Vec3> position;
+  std::vector<Vec3> velocity;         // translational velocity [m/s] (mid-step in leapfrog)
+  std::vector<Quat> orientation;      // body orientation (unit quaternion)
+  std::vector<Vec3> angularVelocity;  // [rad/s] (mid-step)
+  // Accumulators, cleared and refilled every step.
+  std::vector<Vec3> force;   // [N]
+  std::vector<Vec3> torque;  // [N m]
+  // Shape and mass.
+  std::vector<double> radius;   // [m]
+  std::vector<double> mass;     // [kg]
+  std::vector<double> inertia;  // [kg m^2], 2/5 m R^2 for spheres
+  // Cumulative-rotation record (PHYSICS.md §7.4): reference orientation and path integral of |w| dt.
+  std::vector<Quat> referenceOrientation;
+  std::vector<double> rotationPath;  // [rad]
+
+  std::size_t size() const { return position.size(); }
+  void addSphere(const Vec3& x, double r, double density);
+  void clearAccumulators();
+  // Starts the rotation record anew (e.g. at the start of shearing).
+  void resetRotationReference();
+  // Angle [rad] of the composed rotation of particle i since its reference orientation.
+  double rotationAngle(std::size_t i) const;
+  double solidVolume() const;
+};
+
+}  // namespace grainlab

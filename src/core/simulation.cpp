@@ -1,0 +1,268 @@
+#include "core/simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
+#include "geometry/sphere_contacts.hpp"
+
+namespace grainlab {
+
+void Simulation::initialise(double skinFraction) {
+  double rMin = 1e300;
+  for (double r : particles.radius) rMin = std::min(rMin, r);
+  neighbors.skin = skinFraction * rMin;
+  rebuildDue_ = true;
+}
+
+void Simulation::step() {
+  if (rebuildDue_ || neighbors.wallsMoved(box)) {
+    neighbors.build(particles, box);
+    rebuildDue_ = false;
+  }
+  computeContacts();
+  gatherForces();
+  updateWalls();
+  integrate();
+  ++stepCount;
+  time += dt;
+}
+
+void Simulation::computeContacts() {
+  const auto& x = particles.position;
+  const auto& v = particles.velocity;
+  const auto& w = particles.angularVelocity;
+  const auto& rad = particles.radius;
+  const std::size_t nPairs = neighbors.pairA.size();
+  pairForce.resize(nPairs);
+  pairTorqueA.resize(nPairs);
+  pairTorqueB.resize(nPairs);
+  const std::size_t nWall = neighbors.wallParticle.size();
+  wallForce.resize(nWall);
+  wallTorque.resize(nWall);
+  ThreadPartials dissipation(2);  // slip, rolling
+
+#pragma omp parallel
+  {
+  double* partial = dissipation.of(omp_get_thread_num());
+  double slip = 0.0, roll = 0.0;
+#pragma omp for schedule(static)
+  for (std::size_t p = 0; p < nPairs; ++p) {
+    const std::uint32_t a = neighbors.pairA[p], b = neighbors.pairB[p];
+    contact::ContactHistory& h = neighbors.pairHistory[p];
+    const Vec3 branch = x[b] - x[a];
+    const double dist2 = branch.squaredNorm();
+    const double reach = rad[a] + rad[b];
+    if (dist2 >= reach * reach) {
+      h = contact::ContactHistory{};
+      pairForce[p].setZero();
+      pairTorqueA[p].setZero();
+      pairTorqueB[p].setZero();
+      continue;
+    }
+    const geometry::ContactGeometry g = geometry::sphereSphere(branch, dist2, rad[a], rad[b]);
+    if (!h.touching) {
+      h.touching = true;
+      h.prevNormal = g.normal;
+    }
+    contact::ContactKinematics k;
+    k.normal = g.normal;
+    k.prevNormal = h.prevNormal;
+    k.overlap = g.overlap;
+    k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
+    k.relativeSpin = w[b] - w[a];
+    k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
+    k.dt = dt;
+    const contact::ContactResponse res =
+        contact::applyLaw(model.pairParams(rad[a], rad[b]), k, h);
+    pairForce[p] = res.force;
+    pairTorqueA[p] = g.branchA.cross(-res.force) + res.moment;
+    pairTorqueB[p] = g.branchB.cross(res.force) - res.moment;
+    slip += res.slipDissipation;
+    roll += res.rollDissipation;
+  }
+
+#pragma omp for schedule(static)
+  for (std::size_t c = 0; c < nWall; ++c) {
+    const std::uint32_t i = neighbors.wallParticle[c];
+    const Wall& wall = box.walls[neighbors.wallIndex[c]];
+    contact::ContactHistory& h = neighbors.wallHistory[c];
+    const Vec3 n = wall.inwardNormal();
+    Vec3 planePoint = x[i];
+    planePoint[wall.axis] = wall.position;
+    const geometry::ContactGeometry g = geometry::spherePlane(x[i], rad[i], planePoint, n);
+    if (g.overlap <= 0.0) {
+      h = contact::ContactHistory{};
+      wallForce[c].setZero();
+      wallTorque[c].setZero();
+      continue;
+    }
+    if (!h.touching) {
+      h.touching = true;
+      h.prevNormal = n;
+    }
+    Vec3 wallVelocity = Vec3::Zero();
+    wallVelocity[wall.axis] = wall.velocity;
+    contact::ContactKinematics k;
+    k.normal = n;
+    k.prevNormal = h.prevNormal;
+    k.overlap = g.overlap;
+    k.relativeVelocity = v[i] + w[i].cross(g.branchB) - wallVelocity;
+    k.relativeSpin = w[i];
+    k.meanSpinNormal = 0.5 * w[i].dot(n);
+    k.dt = dt;
+    const contact::ContactResponse res =
+        contact::applyLaw(model.wallParams(rad[i], wall.tanFriction), k, h);
+    wallForce[c] = res.force;
+    wallTorque[c] = g.branchB.cross(res.force) - res.moment;
+    slip += res.slipDissipation;
+    roll += res.rollDissipation;
+  }
+  partial[0] += slip;
+  partial[1] += roll;
+  }
+  energy.slip += dissipation.total(0);
+  energy.rolling += dissipation.total(1);
+}
+
+void Simulation::gatherForces() {
+  const std::size_t n = particles.size();
+  auto& f = particles.force;
+  auto& t = particles.torque;
+  // Each particle sums its own contacts in a fixed order: no races, and the sums do not depend on
+  // the number of threads (bit-identical results for any thread count).
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+    for (std::uint32_t s = neighbors.incidentStart[i]; s < neighbors.incidentStart[i + 1]; ++s) {
+      const std::uint32_t e = neighbors.incident[s];
+      const std::uint32_t p = e >> 1;
+      if (e & 1u) {
+        fi += pairForce[p];
+        ti += pairTorqueB[p];
+      } else {
+        fi -= pairForce[p];
+        ti += pairTorqueA[p];
+      }
+    }
+    for (std::uint32_t c = neighbors.wallStart[i]; c < neighbors.wallStart[i + 1]; ++c) {
+      fi += wallForce[c];
+      ti += wallTorque[c];
+    }
+    f[i] = fi;
+    t[i] = ti;
+  }
+  for (Wall& wall : box.walls) {
+    wall.normalForce = 0.0;
+    wall.contactStiffness = 0.0;
+    wall.contacts = 0;
+  }
+  for (std::size_t c = 0; c < neighbors.wallParticle.size(); ++c) {
+    if (!neighbors.wallHistory[c].touching) continue;
+    Wall& wall = box.walls[neighbors.wallIndex[c]];
+    wall.normalForce += wallForce[c].dot(wall.inwardNormal());
+    wall.contactStiffness += model.wallParams(particles.radius[neighbors.wallParticle[c]],
+                                              wall.tanFriction).kn;
+    ++wall.contacts;
+  }
+}
+
+void Simulation::updateWalls() {
+  for (Wall& wall : box.walls) {
+    if (wall.control != WallControl::Stress) continue;
+    const double sigma = wall.normalForce / box.area(wall.axis);
+    const double error = wall.targetStress - sigma;  // > 0: push further in
+    double inwardSpeed = servo.maxSpeed;
+    if (wall.contactStiffness > 0.0) {
+      const double u = error * box.area(wall.axis) / wall.contactStiffness;
+      if (servo.integralSteps > 0.0)
+        wall.servoIntegral = std::clamp(wall.servoIntegral + servo.gain * u / (servo.integralSteps * dt),
+                                        -servo.maxSpeed, servo.maxSpeed);
+      inwardSpeed = servo.gain * u / dt + wall.servoIntegral;
+    } else {
+      wall.servoIntegral = 0.0;
+    }
+    inwardSpeed = std::clamp(inwardSpeed, -servo.maxSpeed, servo.maxSpeed);
+    wall.velocity = wall.side == 0 ? inwardSpeed : -inwardSpeed;
+  }
+  for (Wall& wall : box.walls) {
+    // Work done on the particles by the wall: its force on them times its inward displacement.
+    const double inward = wall.side == 0 ? wall.velocity : -wall.velocity;
+    energy.boundaryWork += wall.normalForce * inward * dt;
+    wall.position += wall.velocity * dt;
+  }
+}
+
+void Simulation::integrate() {
+  const std::size_t n = particles.size();
+  auto& x = particles.position;
+  auto& v = particles.velocity;
+  auto& q = particles.orientation;
+  auto& w = particles.angularVelocity;
+  const auto& xBuild = neighbors.positionsAtBuild();
+  const double alpha = localDamping;
+  const double h = dt;
+  const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
+  double maxDisp2 = 0.0;
+  long badParticle = -1;
+  ThreadPartials dampingWork(1);
+
+#pragma omp parallel reduction(max : maxDisp2)
+  {
+  double* partial = dampingWork.of(omp_get_thread_num());
+#pragma omp for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    // Cundall local damping per component, against the sign of the current (mid-step) velocity.
+    Vec3 f = particles.force[i];
+    Vec3 t = particles.torque[i];
+    Vec3 fd, td;
+    for (int k = 0; k < 3; ++k) {
+      fd[k] = -alpha * std::copysign(std::abs(f[k]), v[i][k]) * (v[i][k] != 0.0);
+      td[k] = -alpha * std::copysign(std::abs(t[k]), w[i][k]) * (w[i][k] != 0.0);
+    }
+    const Vec3 vOld = v[i], wOld = w[i];
+    v[i] += (f + fd) * (h / particles.mass[i]);
+    w[i] += (t + td) * (h / particles.inertia[i]);
+    // Work of the damping forces over the step, with the mean of old and new velocities.
+    partial[0] += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
+    x[i] += v[i] * h;
+    const double wNorm = w[i].norm();
+    if (wNorm > 0.0) {
+      const Quat dq(Eigen::AngleAxisd(wNorm * h, w[i] / wNorm));
+      q[i] = (dq * q[i]).normalized();
+      particles.rotationPath[i] += wNorm * h;
+    }
+    if (!xBuild.empty()) maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
+    const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
+    const double r = particles.radius[i];
+    const bool inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
+    if (!finite || !inside) {
+#pragma omp critical
+      if (badParticle < 0 || static_cast<long>(i) < badParticle) badParticle = static_cast<long>(i);
+    }
+  }
+  }
+  energy.damping -= dampingWork.total(0);
+  if (badParticle >= 0) {
+    const std::size_t i = static_cast<std::size_t>(badParticle);
+    const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
+    throw SimulationError(fmt::format(
+        "numerical instability at step {}: particle {} {} (position {:.6g} {:.6g} {:.6g}, "
+        "velocity {:.6g} {:.6g} {:.6g}); reduce solver.dt_factor or the loading rate",
+        stepCount + 1, i, finite ? "left the box" : "has a non-finite state", x[i][0], x[i][1],
+        x[i][2], v[i][0], v[i][1], v[i][2]));
+  }
+  const double halfSkin = neighbors.halfSkin();
+  if (maxDisp2 > halfSkin * halfSkin) rebuildDue_ = true;
+}
+
+std::size_t Simulation::touchingPairs() const {
+  std::size_t count = 0;
+  for (const auto& h : neighbors.pairHistory) count += h.touching;
+  return count;
+}
+
+}  // namespace grainlab

@@ -1,0 +1,79 @@
+#pragma once
+// The DEM engine for spheres in a box of rigid walls. One call of step() runs the pipeline
+//
+//   broad phase (Verlet list, rebuilt when due) -> narrow phase + contact law (per pair, parallel)
+//   -> force gather (per particle, fixed order) -> walls & servos -> integrator (leapfrog + damping)
+//
+// Laboratory protocols drive it from outside (recorders and stop checks between steps).
+#include <string>
+#include <vector>
+
+#include "contact/models.hpp"
+#include "core/neighbor_list.hpp"
+#include "core/particles.hpp"
+#include "core/walls.hpp"
+
+namespace grainlab {
+
+// Stiffness-based proportional-integral wall servo. The error (sigma_target - sigma) times the wall
+// area over the summed Kn of the wall's contacts is the displacement u that would cancel the error
+// if only those contacts deformed (the PFC / YADE TriaxialStressController scaling, which keeps the
+// loop stable whatever the stiffness). Each step the wall moves by gain*u plus an integral term that
+// accumulates gain*u/integralSteps: a proportional servo alone lags a wall that must keep moving
+// (a dilating sample under a constant sigma3) by an error proportional to its speed; the integral
+// term learns that speed and removes the lag. Speed is capped; a wall with no contact approaches at
+// the cap.
+struct ServoSettings {
+  double gain = 0.2;              // [-], fraction of u per step
+  double integralSteps = 500.0;   // [steps]; 0 disables the integral term
+  double maxSpeed = 0.5;          // [m/s]
+};
+
+// Cumulative energy terms tracked by the engine [J] (PHYSICS.md §7.6, partial).
+struct EnergyLedger {
+  double slip = 0.0;
+  double rolling = 0.0;
+  double damping = 0.0;
+  double boundaryWork = 0.0;  // work done on the particles by the walls
+};
+
+class Simulation {
+ public:
+  Particles particles;
+  WallBox box;
+  NeighborList neighbors;
+  contact::KozickiDonze model;
+  ServoSettings servo;
+  EnergyLedger energy;
+
+  double dt = 0.0;            // [s]
+  double localDamping = 0.3;  // Cundall alpha [-]
+  long stepCount = 0;
+  double time = 0.0;          // [s]
+
+  // Per-contact results of the latest step (parallel to neighbors' arrays).
+  std::vector<Vec3> pairForce;    // force of A on B [N]
+  std::vector<Vec3> pairTorqueA;  // total torque on A from this contact [N m]
+  std::vector<Vec3> pairTorqueB;
+  std::vector<Vec3> wallForce;    // force of the wall on the particle [N]
+  std::vector<Vec3> wallTorque;
+
+  // Sets the neighbour skin from the particle sizes; call after adding particles.
+  void initialise(double skinFraction = 0.2);
+  // Critical time step (PHYSICS.md §4): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
+  // the stiffest contact the particle can have (against a wall).
+  double criticalTimeStep() const;
+  void step();
+
+  // Number of touching particle-particle contacts at the latest step.
+  std::size_t touchingPairs() const;
+
+ private:
+  void computeContacts();
+  void gatherForces();
+  void updateWalls();
+  void integrate();
+  bool rebuildDue_ = true;
+};
+
+}  // namespace grainlab

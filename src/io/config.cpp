@@ -1,0 +1,361 @@
+#include "io/config.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "io/presets.hpp"
+
+namespace grainlab::io {
+
+namespace {
+
+std::string show(const toml::node& node) {
+  std::ostringstream os;
+  node.visit([&](const auto& v) { os << v; });
+  return os.str();
+}
+
+[[noreturn]] void fail(const std::string& key, const std::string& value, const std::string& allowed) {
+  throw InputError(fmt::format("config error: {} = {}: {}", key, value, allowed));
+}
+
+// One [section] of the config: typed getters with defaults and ranges, and a check that every key
+// present was understood.
+class Section {
+ public:
+  Section(const toml::table& root, std::string name) : name_(std::move(name)) {
+    const toml::node* node = root.get(name_);
+    if (node && !node->is_table()) fail(name_, show(*node), "must be a table");
+    table_ = node ? node->as_table() : nullptr;
+  }
+
+  const toml::node* raw(const std::string& key) {
+    used_.insert(key);
+    return table_ ? table_->get(key) : nullptr;
+  }
+  std::string path(const std::string& key) const { return name_ + "." + key; }
+
+  double number(const std::string& key, double def, double lo, double hi, bool loOpen, bool hiOpen,
+                const std::string& allowed) {
+    const toml::node* n = raw(key);
+    if (!n) return def;
+    if (!n->is_number()) fail(path(key), show(*n), "must be a number; " + allowed);
+    const double v = n->value<double>().value();
+    if (!std::isfinite(v) || (loOpen ? v <= lo : v < lo) || (hiOpen ? v >= hi : v > hi))
+      fail(path(key), show(*n), allowed);
+    return v;
+  }
+  long integer(const std::string& key, long def, long lo, long hi) {
+    const toml::node* n = raw(key);
+    if (!n) return def;
+    const std::string allowed = fmt::format("must be an integer in [{}, {}]", lo, hi);
+    if (!n->is_integer()) fail(path(key), show(*n), allowed);
+    const long v = static_cast<long>(n->value<std::int64_t>().value());
+    if (v < lo || v > hi) fail(path(key), show(*n), allowed);
+    return v;
+  }
+  bool boolean(const std::string& key, bool def) {
+    const toml::node* n = raw(key);
+    if (!n) return def;
+    if (!n->is_boolean()) fail(path(key), show(*n), "must be true or false");
+    return n->value<bool>().value();
+  }
+  std::string string(const std::string& key, const std::string& def,
+                     const std::vector<std::string>& allowed) {
+    const toml::node* n = raw(key);
+    if (!n) return def;
+    std::string choices;
+    for (const auto& a : allowed) choices += (choices.empty() ? "\"" : ", \"") + a + "\"";
+    if (!n->is_string()) fail(path(key), show(*n), "must be a string" + (allowed.empty() ? std::string() : " out of " + choices));
+    std::string v = n->value<std::string>().value();
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), v) == allowed.end())
+      fail(path(key), show(*n), "allowed: " + choices);
+    return v;
+  }
+  std::vector<double> numbers(const toml::node& node, const std::string& key) {
+    if (!node.is_array()) fail(key, show(node), "must be an array of numbers");
+    std::vector<double> out;
+    for (const auto& e : *node.as_array()) {
+      if (!e.is_number()) fail(key, show(node), "must be an array of numbers");
+      out.push_back(e.value<double>().value());
+    }
+    return out;
+  }
+  // Every key must be known: a misspelt key is an error, not silently ignored.
+  void finish(const std::vector<std::string>& extraKnown = {}) {
+    if (!table_) return;
+    for (const auto& [k, v] : *table_) {
+      const std::string key(k.str());
+      if (used_.count(key) || std::find(extraKnown.begin(), extraKnown.end(), key) != extraKnown.end())
+        continue;
+      std::string known;
+      for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
+      fail(path(key), show(v), "unknown key; known keys in [" + name_ + "]: " + known);
+    }
+  }
+
+ private:
+  std::string name_;
+  const toml::table* table_ = nullptr;
+  std::set<std::string> used_;
+};
+
+lab::GradingConfig parseGrading(Section& s) {
+  lab::GradingConfig g;
+  const toml::node* node = s.raw("grading");
+  if (!node) return g;
+  const std::string key = s.path("grading");
+  if (!node->is_table()) fail(key, show(*node), "must be an inline table, e.g. { type = \"uniform\", d_min = 2e-3, d_max = 8e-3 }");
+  const toml::table& t = *node->as_table();
+  std::set<std::string> known;
+  auto get = [&](const char* k) { known.insert(k); return t.get(k); };
+  const toml::node* type = get("type");
+  if (!type || !type->is_string()) fail(key + ".type", type ? show(*type) : "(missing)", "allowed: \"curve\", \"uniform\", \"list\"");
+  g.type = type->value<std::string>().value();
+  if (g.type == "curve") {
+    const toml::node* d = get("diameters");
+    const toml::node* p = get("passing");
+    if (!d) fail(key + ".diameters", "(missing)", "an array of sieve diameters [m] is required");
+    if (!p) fail(key + ".passing", "(missing)", "an array of percent passing by mass is required");
+    g.diameters = s.numbers(*d, key + ".diameters");
+    g.passing = s.numbers(*p, key + ".passing");
+    if (g.diameters.size() < 2 || g.diameters.size() != g.passing.size())
+      fail(key + ".passing", show(*p), "must have one value per diameter (at least 2)");
+    for (std::size_t i = 0; i < g.diameters.size(); ++i) {
+      if (!(g.diameters[i] > 0.0)) fail(key + ".diameters", show(*d), "diameters must be > 0 [m]");
+      if (i > 0 && !(g.diameters[i] > g.diameters[i - 1])) fail(key + ".diameters", show(*d), "diameters must increase strictly");
+      if (i > 0 && g.passing[i] < g.passing[i - 1]) fail(key + ".passing", show(*p), "percent passing must not decrease");
+    }
+    if (g.passing.front() != 0.0 || g.passing.back() != 100.0)
+      fail(key + ".passing", show(*p), "must start at 0 and end at 100 (percent passing by mass)");
+  } else if (g.type == "uniform") {
+    const toml::node* lo = get("d_min");
+    const toml::node* hi = get("d_max");
+    if (!lo || !lo->is_number()) fail(key + ".d_min", lo ? show(*lo) : "(missing)", "a diameter > 0 [m] is required");
+    if (!hi || !hi->is_number()) fail(key + ".d_max", hi ? show(*hi) : "(missing)", "a diameter >= d_min [m] is required");
+    g.dMin = lo->value<double>().value();
+    g.dMax = hi->value<double>().value();
+    if (!(g.dMin > 0.0)) fail(key + ".d_min", show(*lo), "must be > 0 [m]");
+    if (!(g.dMax >= g.dMin)) fail(key + ".d_max", show(*hi), "must be >= d_min [m]");
+  } else if (g.type == "list") {
+    const toml::node* f = get("file");
+    if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
+    g.file = f->value<std::string>().value();
+    if (!std::filesystem::exists(g.file)) fail(key + ".file", show(*f), "file not found");
+  } else {
+    fail(key + ".type", show(*type), "allowed: \"curve\", \"uniform\", \"list\"");
+  }
+  for (const auto& [k, v] : t)
+    if (!known.count(std::string(k.str())))
+      fail(key + "." + std::string(k.str()), show(v), "unknown key for grading type \"" + g.type + "\"");
+  return g;
+}
+
+}  // namespace
+
+toml::table loadConfigTable(const std::string& source) {
+  try {
+    if (source.rfind("preset:", 0) == 0) {
+      const std::string name = source.substr(7);
+      const Preset* p = findPreset(name);
+      if (!p) {
+        std::string names;
+        for (const auto& q : presets()) names += (names.empty() ? "" : ", ") + q.name;
+        throw InputError(fmt::format("unknown preset \"{}\"; available: {}", name, names));
+      }
+      return toml::parse(p->toml, "preset:" + name);
+    }
+    if (!std::filesystem::exists(source))
+      throw InputError(fmt::format("config file \"{}\" not found", source));
+    return toml::parse_file(source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("config error: {} line {}: {}", source, e.source().begin.line,
+                                 e.description()));
+  }
+}
+
+void applyOverride(toml::table& table, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--set {}: expected KEY=VALUE with a dotted key, e.g. contact.beta=0", assignment));
+  const std::string key = assignment.substr(0, eq);
+  const std::string value = assignment.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    // A bare word (e.g. model=rolling-linear) is meant as a string.
+    toml::table t;
+    t.insert("v", value);
+    parsed = std::move(t);
+  }
+  toml::table* cur = &table;
+  std::size_t start = 0;
+  while (true) {
+    const auto dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (part.empty()) throw InputError(fmt::format("--set {}: empty component in key \"{}\"", assignment, key));
+    if (dot == std::string::npos) {
+      cur->insert_or_assign(part, *parsed.get("v"));
+      return;
+    }
+    toml::node* next = cur->get(part);
+    if (!next) {
+      cur->insert(part, toml::table{});
+      next = cur->get(part);
+    }
+    if (!next->is_table())
+      throw InputError(fmt::format("--set {}: \"{}\" is not a table", assignment, key.substr(0, dot)));
+    cur = next->as_table();
+    start = dot + 1;
+  }
+}
+
+lab::RunConfig parseConfig(const toml::table& root) {
+  static const std::vector<std::string> sections{"sample", "contact", "test", "solver", "output"};
+  for (const auto& [k, v] : root) {
+    const std::string key(k.str());
+    if (std::find(sections.begin(), sections.end(), key) == sections.end())
+      fail(key, show(v), "unknown section; allowed: [sample], [contact], [test], [solver], [output]");
+  }
+  lab::RunConfig c;
+
+  Section s(root, "sample");
+  c.sample.nParticles = static_cast<int>(s.integer("n_particles", c.sample.nParticles, 2, 50'000'000));
+  c.sample.grading = parseGrading(s);
+  c.sample.density = s.number("density", c.sample.density, 0.0, 1e6, true, false, "must be > 0 [kg/m^3]");
+  c.sample.e0 = s.number("e0", c.sample.e0, 0.0, 5.0, true, false, "must be > 0 and <= 5 (void ratio)");
+  c.sample.seed = static_cast<std::uint64_t>(s.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+  if (const toml::node* n = s.raw("prep_friction_deg")) {
+    if (n->is_string() && n->value<std::string>().value() == "auto") {
+      c.sample.prepFrictionDeg.reset();
+    } else {
+      c.sample.prepFrictionDeg = s.number("prep_friction_deg", 0.0, 0.0, 90.0, false, true,
+                                         "must be \"auto\" or an angle in [0, 90) [deg]");
+    }
+  }
+  c.sample.e0Tolerance = s.number("e0_tolerance", c.sample.e0Tolerance, 0.0, 1.0, true, false, "must be in (0, 1]");
+  c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
+                                       "must be in [1, 20] (loose placement before compaction)");
+  s.finish();
+
+  Section ct(root, "contact");
+  c.contact.model = ct.string("model", c.contact.model, {"kozicki"});
+  c.contact.young = ct.number("young", c.contact.young, 0.0, 1e15, true, false, "must be > 0 [Pa]");
+  c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 1.0, false, false, "must be in [0, 1] (Ks = poisson * Kn)");
+  c.contact.frictionDeg = ct.number("friction_deg", c.contact.frictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
+  c.contact.beta = ct.number("beta", c.contact.beta, 0.0, 1e6, false, false, "must be >= 0");
+  c.contact.eta = ct.number("eta", c.contact.eta, 0.0, 1e6, false, false, "must be >= 0");
+  c.contact.wallFrictionDeg = ct.number("wall_friction_deg", c.contact.wallFrictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
+  ct.finish();
+
+  Section t(root, "test");
+  c.test.type = t.string("type", c.test.type, {"isotropic", "triaxial"});
+  c.test.boundary = t.string("boundary", c.test.boundary, {"walls"});
+  c.test.confiningPressure = t.number("confining_pressure", c.test.confiningPressure, 0.0, 1e10, true, false, "must be > 0 [Pa]");
+  if (const toml::node* n = t.raw("axial_strain_rate")) {
+    if (n->is_string() && n->value<std::string>().value() == "auto") {
+      c.test.axialStrainRate.reset();
+    } else {
+      c.test.axialStrainRate = t.number("axial_strain_rate", 0.0, 0.0, 1e3, true, false,
+                                        "must be \"auto\" or a rate > 0 [1/s]");
+    }
+  }
+  c.test.finalAxialStrain = t.number("final_axial_strain", c.test.finalAxialStrain, 0.0, 0.5, true, false, "must be in (0, 0.5]");
+  t.finish();
+
+  Section so(root, "solver");
+  c.solver.damping = so.number("damping", c.solver.damping, 0.0, 1.0, false, true, "must be in [0, 1)");
+  c.solver.dtFactor = so.number("dt_factor", c.solver.dtFactor, 0.0, 1.0, true, false, "must be in (0, 1] (fraction of the critical time step)");
+  if (so.raw("dt"))
+    c.solver.dt = so.number("dt", 0.0, 0.0, 1.0, true, false, "must be > 0 [s] (and at most the critical time step)");
+  c.solver.forceDt = so.boolean("force_dt", c.solver.forceDt);
+  c.solver.threads = static_cast<int>(so.integer("threads", c.solver.threads, 1, 1024));
+  c.solver.unbalancedTolerance = so.number("unbalanced_tolerance", c.solver.unbalancedTolerance, 0.0, 1.0, true, false, "must be in (0, 1]");
+  c.solver.stressTolerance = so.number("stress_tolerance", c.solver.stressTolerance, 0.0, 0.5, true, false, "must be in (0, 0.5]");
+  c.solver.servoGain = so.number("servo_gain", c.solver.servoGain, 0.0, 1.0, true, false, "must be in (0, 1]");
+  c.solver.servoIntegralSteps = so.number("servo_integral_steps", c.solver.servoIntegralSteps, 0.0, 1e9, false, false, "must be >= 0 [steps] (0 disables the integral term)");
+  c.solver.servoMaxSpeed = so.number("servo_max_speed", c.solver.servoMaxSpeed, 0.0, 1e3, true, false, "must be > 0 [m/s]");
+  c.solver.skinFraction = so.number("skin_fraction", c.solver.skinFraction, 0.0, 2.0, true, false, "must be in (0, 2]");
+  c.solver.maxSteps = so.integer("max_steps", c.solver.maxSteps, 1, std::numeric_limits<std::int64_t>::max());
+  so.finish();
+
+  Section o(root, "output");
+  c.output.dir = o.string("dir", c.output.dir, {});
+  if (c.output.dir.empty()) fail("output.dir", "\"\"", "must be a non-empty path");
+  c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 0.0, 0.1, true, false, "must be in (0, 0.1]");
+  c.output.plots = o.boolean("plots", c.output.plots);
+  o.finish();
+  return c;
+}
+
+toml::table resolvedTable(const lab::RunConfig& c) {
+  toml::table grading;
+  grading.insert("type", c.sample.grading.type);
+  if (c.sample.grading.type == "curve") {
+    toml::array d, p;
+    for (double v : c.sample.grading.diameters) d.push_back(v);
+    for (double v : c.sample.grading.passing) p.push_back(v);
+    grading.insert("diameters", d);
+    grading.insert("passing", p);
+  } else if (c.sample.grading.type == "uniform") {
+    grading.insert("d_min", c.sample.grading.dMin);
+    grading.insert("d_max", c.sample.grading.dMax);
+  } else {
+    grading.insert("file", c.sample.grading.file);
+  }
+  toml::table sample{
+      {"n_particles", c.sample.nParticles},
+      {"grading", grading},
+      {"density", c.sample.density},
+      {"e0", c.sample.e0},
+      {"seed", static_cast<std::int64_t>(c.sample.seed)},
+      {"e0_tolerance", c.sample.e0Tolerance},
+      {"initial_void_ratio", c.sample.initialVoidRatio},
+  };
+  if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
+  else sample.insert("prep_friction_deg", "auto");
+  toml::table contact{{"model", c.contact.model},       {"young", c.contact.young},
+                      {"poisson", c.contact.poisson},   {"friction_deg", c.contact.frictionDeg},
+                      {"beta", c.contact.beta},         {"eta", c.contact.eta},
+                      {"wall_friction_deg", c.contact.wallFrictionDeg}};
+  toml::table test{{"type", c.test.type},
+                   {"boundary", c.test.boundary},
+                   {"confining_pressure", c.test.confiningPressure},
+                   {"final_axial_strain", c.test.finalAxialStrain}};
+  if (c.test.axialStrainRate) test.insert("axial_strain_rate", *c.test.axialStrainRate);
+  else test.insert("axial_strain_rate", "auto");
+  toml::table solver{{"damping", c.solver.damping},
+                     {"dt_factor", c.solver.dtFactor},
+                     {"force_dt", c.solver.forceDt},
+                     {"threads", c.solver.threads},
+                     {"unbalanced_tolerance", c.solver.unbalancedTolerance},
+                     {"stress_tolerance", c.solver.stressTolerance},
+                     {"servo_gain", c.solver.servoGain},
+                     {"servo_integral_steps", c.solver.servoIntegralSteps},
+                     {"servo_max_speed", c.solver.servoMaxSpeed},
+                     {"skin_fraction", c.solver.skinFraction},
+                     {"max_steps", static_cast<std::int64_t>(c.solver.maxSteps)}};
+  if (c.solver.dt) solver.insert("dt", *c.solver.dt);
+  toml::table output{{"dir", c.output.dir},
+                     {"record_every_strain", c.output.recordEveryStrain},
+                     {"plots", c.output.plots}};
+  return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
+                     {"solver", solver}, {"output", output}};
+}
+
+std::string toTomlString(const toml::table& table) {
+  std::ostringstream os;
+  os << table << "\n";
+  return os.str();
+}
+
+}  // namespace grainlab::io

@@ -1,0 +1,49 @@
+#include "io/results.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "core/errors.hpp"
+
+namespace grainlab::io {
+
+void writeFileAtomic(const std::filesystem::path& path, const std::string& content) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  const std::filesystem::path tmp = path.string() + fmt::format(".tmp{}", ::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(fmt::format("cannot write {}", tmp.string()));
+    out << content;
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("error writing {}", tmp.string()));
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string timeseriesCsv(const std::vector<lab::Record>& records) {
+  std::string s =
+      "step,time,eps1,eps_v,sigma1,sigma2,sigma3,q,p,e,phi_deg,Z,unbalanced,eps2,eps3,"
+      "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
+      "W_boundary,D_slip,D_roll,D_damping\n";
+  for (const auto& r : records) {
+    const double values[] = {r.time, r.eps1, r.epsV, r.sigma1, r.sigma2, r.sigma3, r.q, r.p, r.e,
+                             r.phiDeg, r.coordination, r.unbalanced, r.eps2, r.eps3,
+                             r.inertialNumber, r.sigma1Contact, r.sigma2Contact, r.sigma3Contact,
+                             r.kinetic, r.elastic, r.workBoundary, r.dissipSlip, r.dissipRoll,
+                             r.dissipDamping};
+    s += fmt::format("{}", r.step);
+    for (double v : values) {
+      if (!std::isfinite(v))
+        throw SimulationError(fmt::format("non-finite value in the time series at step {}", r.step));
+      s += fmt::format(",{:.10g}", v);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+}  // namespace grainlab::io

@@ -1,0 +1,103 @@
+#include "lab/macro.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/types.hpp"
+
+namespace grainlab::lab {
+
+double mobilisedFrictionDeg(double s1, double s3) {
+  const double sum = s1 + s3;
+  if (!(sum > 0.0)) return 0.0;
+  return radToDeg(std::asin(std::clamp((s1 - s3) / sum, -1.0, 1.0)));
+}
+
+double dilatancyAngleDeg(double r) {
+  return radToDeg(std::asin(std::clamp(-r / (2.0 - r), -1.0, 1.0)));
+}
+
+double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t b, std::size_t e) {
+  const double n = static_cast<double>(e - b);
+  if (e <= b + 1) return 0.0;
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = b; i < e; ++i) {
+    mx += x[i];
+    my += y[i];
+  }
+  mx /= n;
+  my /= n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = b; i < e; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  return sxx > 0.0 ? sxy / sxx : 0.0;
+}
+
+MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
+  MacroParameters m;
+  const std::size_t n = c.eps1.size();
+  if (n < 2) return m;
+  std::vector<double> q(n), p(n), phi(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    q[i] = c.sigma1[i] - c.sigma3[i];
+    p[i] = (c.sigma1[i] + 2.0 * c.sigma3[i]) / 3.0;
+    phi[i] = mobilisedFrictionDeg(c.sigma1[i], c.sigma3[i]);
+  }
+  const std::size_t peak = std::max_element(phi.begin(), phi.end()) - phi.begin();
+  m.phiPeakDeg = phi[peak];
+  m.eps1AtPeak = c.eps1[peak];
+  m.qPeak = *std::max_element(q.begin(), q.end());
+
+  const double epsEnd = c.eps1.back();
+  m.residualFrom = (1.0 - s.residualFraction) * epsEnd;
+  double sumPhi = 0.0, sumRatio = 0.0, sumE = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (c.eps1[i] < m.residualFrom) continue;
+    sumPhi += phi[i];
+    sumRatio += p[i] > 0.0 ? q[i] / p[i] : 0.0;
+    sumE += c.voidRatio.empty() ? 0.0 : c.voidRatio[i];
+    ++count;
+  }
+  if (count > 0) {
+    m.phiResDeg = sumPhi / count;
+    m.csStressRatio = sumRatio / count;
+    m.csVoidRatio = sumE / count;
+  }
+
+  // Dilatancy: centred least-squares slope of eps_v on eps1.
+  m.psiMaxDeg = -90.0;
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
+    while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
+    if (hi - lo < 3) continue;
+    const double psi = dilatancyAngleDeg(slope(c.eps1, c.epsV, lo, hi));
+    if (psi > m.psiMaxDeg) {
+      m.psiMaxDeg = psi;
+      m.eps1AtPsiMax = c.eps1[i];
+    }
+  }
+  if (m.psiMaxDeg == -90.0) m.psiMaxDeg = 0.0;
+
+  // Small-strain stiffness.
+  std::size_t end = 0;
+  while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
+  end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));
+  m.youngModulus = slope(c.eps1, q, 0, end);
+  m.poisson = 0.5 * (1.0 - slope(c.eps1, c.epsV, 0, end));
+  const double half = 0.5 * m.qPeak;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (q[i] >= half) {
+      const double f = (half - q[i - 1]) / (q[i] - q[i - 1]);
+      const double e = c.eps1[i - 1] + f * (c.eps1[i] - c.eps1[i - 1]);
+      m.e50 = e > 0.0 ? (half - q[0]) / (e - c.eps1[0]) : 0.0;
+      break;
+    }
+  }
+  return m;
+}
+
+}  // namespace grainlab::lab

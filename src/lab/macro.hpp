@@ -1,0 +1,52 @@
+#pragma once
+// Macro-parameters of a drained triaxial test from its recorded curves (PHYSICS.md §7.3).
+// Pure functions of the curves, so they can be tested on synthetic data with known answers.
+#include <vector>
+
+namespace grainlab::lab {
+
+struct TriaxialCurves {
+  std::vector<double> eps1;    // axial strain [-], compression positive
+  std::vector<double> epsV;    // volumetric strain [-], contraction positive
+  std::vector<double> sigma1;  // [Pa]
+  std::vector<double> sigma3;  // mean lateral stress [Pa]
+  std::vector<double> voidRatio;
+};
+
+// Windows used, stated here and in the README:
+//  - residual / critical state: the last 20 % of the final axial strain, eps1 >= 0.8 eps1_final;
+//  - dilatancy rate: local least-squares slope d(eps_v)/d(eps1) over a centred window of
+//    +-dilatancyHalfWindow axial strain (default 0.005);
+//  - E and nu: least-squares slopes of q and eps_v on eps1 over eps1 <= elasticWindow (0.1 %),
+//    at least the first 3 records after the start; E50 the secant to half the peak q.
+struct MacroSettings {
+  double residualFraction = 0.2;
+  double dilatancyHalfWindow = 0.005;
+  double elasticWindow = 0.001;
+};
+
+struct MacroParameters {
+  double phiPeakDeg = 0.0;
+  double eps1AtPeak = 0.0;
+  double qPeak = 0.0;
+  double phiResDeg = 0.0;
+  double residualFrom = 0.0;  // eps1 where the residual window starts
+  double psiMaxDeg = 0.0;
+  double eps1AtPsiMax = 0.0;
+  double youngModulus = 0.0;  // [Pa]
+  double e50 = 0.0;           // [Pa]
+  double poisson = 0.0;
+  double csStressRatio = 0.0;  // q/p over the residual window
+  double csVoidRatio = 0.0;
+};
+
+// phi = asin((sigma1 - sigma3)/(sigma1 + sigma3)) [deg]
+double mobilisedFrictionDeg(double sigma1, double sigma3);
+// psi = asin(-r/(2 - r)) with r = d(eps_v)/d(eps1) [deg]; positive in dilation.
+double dilatancyAngleDeg(double rate);
+// Least-squares slope of y on x over indices [begin, end).
+double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t begin, std::size_t end);
+
+MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s = {});
+
+}  // namespace grainlab::lab

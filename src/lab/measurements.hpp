@@ -1,0 +1,26 @@
+#pragma once
+// What is measured on an assembly in a wall box (PHYSICS.md §7.1, §7.2, §7.5 in part).
+#include "core/simulation.hpp"
+
+namespace grainlab::lab {
+
+// Mean |net force| per particle over mean |contact force| per contact (particle-particle and
+// particle-wall contacts). Quasi-static when small (e.g. < 0.01). Zero contacts gives 1.
+double unbalancedForceRatio(const Simulation& sim);
+
+// Love–Weber stress from contacts, compression positive: sigma = (1/V) sum_p sum_c f^c (x^c - x^p)
+// with the sign flipped, over all contacts of every particle, walls included (the per-particle form
+// of [O] eq. 2.3). For a particle pair it reduces to f_AB (x) branch. V is the box volume.
+Mat3 contactStress(const Simulation& sim);
+
+// Wall stresses (sigma_xx, sigma_yy, sigma_zz), compression positive [Pa].
+Vec3 wallStress(const Simulation& sim);
+
+double voidRatio(const Simulation& sim);
+// Z = 2 Nc / Np over touching particle-particle contacts.
+double coordinationNumber(const Simulation& sim);
+double kineticEnergy(const Simulation& sim);
+// Elastic energy stored in the contact springs (normal, shear, moment) [J].
+double elasticEnergy(const Simulation& sim);
+
+}  // namespace grainlab::lab

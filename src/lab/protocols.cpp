@@ -1,0 +1,254 @@
+#include "lab/protocols.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "lab/macro.hpp"
+#include "lab/measurements.hpp"
+#include "lab/placement.hpp"
+
+namespace grainlab::lab {
+
+void configureSolver(const RunConfig& c, Simulation& sim) {
+  sim.model.young = c.contact.young;
+  sim.model.poisson = c.contact.poisson;
+  sim.model.beta = c.contact.beta;
+  sim.model.eta = c.contact.eta;
+  sim.model.tanFriction = std::tan(degToRad(c.contact.frictionDeg));
+  for (Wall& w : sim.box.walls) w.tanFriction = std::tan(degToRad(c.contact.wallFrictionDeg));
+  sim.localDamping = c.solver.damping;
+  sim.servo.gain = c.solver.servoGain;
+  sim.servo.integralSteps = c.solver.servoIntegralSteps;
+  sim.servo.maxSpeed = c.solver.servoMaxSpeed;
+  sim.initialise(c.solver.skinFraction);
+  const double dtc = sim.criticalTimeStep();
+  if (c.solver.dt) {
+    if (*c.solver.dt > dtc && !c.solver.forceDt)
+      throw InputError(fmt::format(
+          "config error: solver.dt = {:.6g}: above the critical time step {:.6g} s of this sample; "
+          "allowed: dt <= {:.6g} (or solver.force_dt = true)", *c.solver.dt, dtc, dtc));
+    sim.dt = *c.solver.dt;
+  } else {
+    sim.dt = c.solver.dtFactor * dtc;
+  }
+}
+
+Laboratory::Laboratory(const RunConfig& config, ProgressFn progress)
+    : config_(config), progress_(std::move(progress)) {}
+
+EquilibriumState Laboratory::equilibriumState() const {
+  return {wallStress(sim_), contactStress(sim_), unbalancedForceRatio(sim_), voidRatio(sim_)};
+}
+
+long Laboratory::consolidate(double pressure, const std::string& phase) {
+  for (Wall& w : sim_.box.walls) {
+    w.control = WallControl::Stress;
+    w.targetStress = pressure;
+  }
+  const int checkEvery = 100;
+  const double stressTol = config_.solver.stressTolerance;
+  const double unbTol = config_.solver.unbalancedTolerance;
+  long steps = 0;
+  double worst = 1.0;
+  while (true) {
+    sim_.step();
+    ++steps;
+    if (steps % checkEvery != 0) continue;
+    const Vec3 s = wallStress(sim_);
+    double dev = 0.0;
+    for (int a = 0; a < 3; ++a) dev = std::max(dev, std::abs(s[a] - pressure) / pressure);
+    const double unb = unbalancedForceRatio(sim_);
+    if (dev < stressTol && unb < unbTol) break;
+    // Progress: how far the worse of the two criteria is from its tolerance, on a log scale.
+    worst = std::max(dev / stressTol, unb / unbTol);
+    if (progress_ && steps % (10 * checkEvery) == 0)
+      progress_(phase, std::clamp(1.0 - std::log10(std::max(worst, 1.0)) / 3.0, 0.0, 0.99), steps);
+    if (steps >= config_.solver.maxSteps)
+      throw SimulationError(fmt::format(
+          "{}: no equilibrium after {} steps (stress off target by {:.3g} %, unbalanced force ratio "
+          "{:.3g}); raise solver.max_steps or check the parameters", phase, steps, 100.0 * dev, unb));
+  }
+  if (progress_) progress_(phase, 1.0, steps);
+  return steps;
+}
+
+double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Simulation& out,
+                                       long& steps) {
+  sim_ = loose;
+  setFriction(muDeg);
+  steps += consolidate(config_.test.confiningPressure, fmt::format("compaction (mu_prep {:.1f} deg)", muDeg));
+  setFriction(config_.contact.frictionDeg);
+  steps += consolidate(config_.test.confiningPressure, "equilibrium at full friction");
+  out = sim_;
+  return voidRatio(sim_);
+}
+
+PreparationResult Laboratory::prepare() {
+  PreparationResult result;
+  Rng rng(config_.sample.seed);
+  const std::vector<double> diameters =
+      sampleDiameters(config_.sample.grading, config_.sample.nParticles, rng);
+  result.grading = gradingStats(diameters);
+  d50_ = result.grading.d50;
+  placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng,
+             sim_.particles, sim_.box);
+  configureSolver(config_, sim_);
+  const Simulation loose = sim_;
+
+  const double target = config_.sample.e0;
+  const double tol = config_.sample.e0Tolerance;
+  Simulation best;
+  double bestErr = 1e300;
+  auto trial = [&](double mu) {
+    Simulation out;
+    const double e = compactWithFriction(loose, mu, out, result.steps);
+    result.search.emplace_back(mu, e);
+    if (std::abs(e - target) < bestErr) {
+      bestErr = std::abs(e - target);
+      best = std::move(out);
+      result.prepFrictionDeg = mu;
+      result.e0 = e;
+    }
+    return e;
+  };
+
+  if (config_.sample.prepFrictionDeg) {
+    trial(*config_.sample.prepFrictionDeg);
+  } else {
+    // e(mu_prep) grows with mu_prep. Frictionless compaction gives the densest state; bracket the
+    // target, then regula falsi (Illinois variant) on mu_prep.
+    double muLo = 0.0, eLo = trial(0.0);
+    if (target < eLo - tol)
+      throw InputError(fmt::format(
+          "config error: sample.e0 = {}: denser than this grading reaches (frictionless compaction "
+          "gives e = {:.3f}); allowed: e0 >= {:.3f}", target, eLo, eLo - tol));
+    if (bestErr > tol) {
+      double muHi = 0.0, eHi = eLo;
+      for (double mu : {15.0, 35.0, 60.0, 89.0}) {
+        muHi = mu;
+        eHi = trial(mu);
+        if (eHi >= target - tol) break;
+        muLo = mu;
+        eLo = eHi;
+      }
+      if (eHi < target - tol)
+        throw InputError(fmt::format(
+            "config error: sample.e0 = {}: looser than this preparation reaches (mu_prep = 89 deg "
+            "gives e = {:.3f}); allowed: e0 <= {:.3f}", target, eHi, eHi + tol));
+      int side = 0;
+      for (int it = 0; it < 10 && bestErr > tol; ++it) {
+        double mu = muLo + (target - eLo) * (muHi - muLo) / (eHi - eLo);
+        if (!(mu > muLo && mu < muHi)) mu = 0.5 * (muLo + muHi);
+        const double e = trial(mu);
+        if (e < target) {
+          muLo = mu;
+          eLo = e;
+          if (side == -1) eHi = target + 0.5 * (eHi - target);
+          side = -1;
+        } else {
+          muHi = mu;
+          eHi = e;
+          if (side == 1) eLo = target - 0.5 * (target - eLo);
+          side = 1;
+        }
+      }
+    }
+  }
+  sim_ = std::move(best);
+  result.state = equilibriumState();
+  return result;
+}
+
+Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate) const {
+  Record r;
+  r.step = sim_.stepCount;
+  r.time = sim_.time;
+  const WallBox& b = sim_.box;
+  r.eps1 = (h0 - b.length(2)) / h0;
+  r.eps2 = (l0[0] - b.length(0)) / l0[0];
+  r.eps3 = (l0[1] - b.length(1)) / l0[1];
+  r.epsV = (v0 - b.volume()) / v0;
+  const Vec3 s = wallStress(sim_);
+  r.sigma1 = s[2];
+  r.sigma2 = s[0];
+  r.sigma3 = s[1];
+  const double lateral = 0.5 * (r.sigma2 + r.sigma3);
+  r.q = r.sigma1 - lateral;
+  r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3.0;
+  r.e = voidRatio(sim_);
+  r.phiDeg = mobilisedFrictionDeg(r.sigma1, lateral);
+  r.coordination = coordinationNumber(sim_);
+  r.unbalanced = unbalancedForceRatio(sim_);
+  r.inertialNumber = strainRate * d50_ * std::sqrt(config_.sample.density / std::max(r.p, 1e-300));
+  const Mat3 sc = contactStress(sim_);
+  r.sigma1Contact = sc(2, 2);
+  r.sigma2Contact = sc(0, 0);
+  r.sigma3Contact = sc(1, 1);
+  r.kinetic = kineticEnergy(sim_);
+  r.elastic = elasticEnergy(sim_);
+  r.workBoundary = sim_.energy.boundaryWork;
+  r.dissipSlip = sim_.energy.slip;
+  r.dissipRoll = sim_.energy.rolling;
+  r.dissipDamping = sim_.energy.damping;
+  return r;
+}
+
+ShearResult Laboratory::shear() {
+  ShearResult out;
+  const double p = config_.test.confiningPressure;
+  const double rho = config_.sample.density;
+  setFriction(config_.contact.frictionDeg);
+  // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3.
+  out.strainRate = config_.test.axialStrainRate.value_or(1e-3 / (d50_ * std::sqrt(rho / p)));
+  out.inertialNumber = out.strainRate * d50_ * std::sqrt(rho / p);
+
+  WallBox& box = sim_.box;
+  const double h0 = box.length(2), v0 = box.volume();
+  const Vec3 l0(box.length(0), box.length(1), box.length(2));
+  for (int a = 0; a < 2; ++a)
+    for (int side = 0; side < 2; ++side) {
+      Wall& w = box.walls[WallBox::index(a, side)];
+      w.control = WallControl::Stress;
+      w.targetStress = p;
+    }
+  // Platens at constant speed: engineering axial strain rate on the initial height.
+  box.lower(2).control = WallControl::Velocity;
+  box.lower(2).velocity = 0.5 * out.strainRate * h0;
+  box.upper(2).control = WallControl::Velocity;
+  box.upper(2).velocity = -0.5 * out.strainRate * h0;
+  sim_.particles.resetRotationReference();
+  sim_.energy = EnergyLedger{};
+
+  const double finalStrain = config_.test.finalAxialStrain;
+  const double every = config_.output.recordEveryStrain;
+  out.records.push_back(measure(h0, v0, l0, out.strainRate));
+  // Records are ten times denser below 1 % axial strain, where E and nu are measured.
+  double nextRecord = std::min(every, 0.1 * every);
+  const long startStep = sim_.stepCount;
+  while (true) {
+    sim_.step();
+    const double eps1 = (h0 - box.length(2)) / h0;
+    const bool last = eps1 >= finalStrain;
+    if (eps1 >= nextRecord || last) {
+      Record r = measure(h0, v0, l0, out.strainRate);
+      out.maxLateralDeviation = std::max(
+          {out.maxLateralDeviation, std::abs(r.sigma2 - p) / p, std::abs(r.sigma3 - p) / p});
+      out.records.push_back(r);
+      while (nextRecord <= eps1) nextRecord += eps1 < 0.01 ? 0.1 * every : every;
+    }
+    if (progress_ && (sim_.stepCount - startStep) % 2000 == 0)
+      progress_("triaxial shearing", std::min(1.0, eps1 / finalStrain), sim_.stepCount - startStep);
+    if (last) break;
+    if (sim_.stepCount - startStep >= config_.solver.maxSteps)
+      throw SimulationError(fmt::format("triaxial shearing: reached solver.max_steps = {} at eps1 = {:.4f}",
+                                        config_.solver.maxSteps, eps1));
+  }
+  if (progress_) progress_("triaxial shearing", 1.0, sim_.stepCount - startStep);
+  out.steps = sim_.stepCount - startStep;
+  return out;
+}
+
+}  // namespace grainlab::lab

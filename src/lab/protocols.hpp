@@ -1,0 +1,87 @@
+#pragma once
+// Laboratory protocols in a box of rigid walls (LAB.md tests 1–3): sample preparation with a
+// preparation friction (searched to meet a target e0), isotropic compression to the confining
+// pressure, and drained triaxial compression.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/simulation.hpp"
+#include "lab/grading.hpp"
+#include "lab/run_config.hpp"
+
+namespace grainlab::lab {
+
+// Called during long phases: phase name, fraction done in [0, 1], steps so far in the phase.
+using ProgressFn = std::function<void(const std::string& phase, double fraction, long steps)>;
+
+// One row of the time series (PHYSICS.md §0 signs: compression positive, eps_v > 0 contraction).
+struct Record {
+  long step = 0;
+  double time = 0.0;
+  double eps1 = 0.0, eps2 = 0.0, eps3 = 0.0, epsV = 0.0;
+  double sigma1 = 0.0, sigma2 = 0.0, sigma3 = 0.0;  // wall stresses: axial z, lateral x, lateral y
+  double q = 0.0, p = 0.0, e = 0.0, phiDeg = 0.0;
+  double coordination = 0.0, unbalanced = 0.0, inertialNumber = 0.0;
+  double sigma1Contact = 0.0, sigma2Contact = 0.0, sigma3Contact = 0.0;
+  double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
+         dissipDamping = 0.0;
+};
+
+struct EquilibriumState {
+  Vec3 wallStress;   // [Pa]
+  Mat3 contactStress;
+  double unbalanced;
+  double voidRatio;
+};
+
+struct PreparationResult {
+  double e0 = 0.0;                 // reached
+  double prepFrictionDeg = 0.0;    // used for the final sample
+  std::vector<std::pair<double, double>> search;  // (mu_prep deg, e reached) per trial
+  long steps = 0;
+  GradingStats grading{};
+  EquilibriumState state{};
+};
+
+struct ShearResult {
+  std::vector<Record> records;
+  double strainRate = 0.0;        // [1/s]
+  double inertialNumber = 0.0;    // eps_dot d50 sqrt(rho/p)
+  double maxLateralDeviation = 0.0;  // max |sigma_lat - p|/p over the shear phase
+  long steps = 0;
+};
+
+class Laboratory {
+ public:
+  Laboratory(const RunConfig& config, ProgressFn progress = {});
+
+  // Draws the grading, places particles loosely, compacts to the confining pressure with the
+  // preparation friction (searched when not given) and re-equilibrates with friction restored.
+  PreparationResult prepare();
+  // Drained triaxial compression of the prepared sample (platens at constant speed, lateral walls
+  // servo-controlled at sigma3 = p) to the final axial strain.
+  ShearResult shear();
+
+  Simulation& simulation() { return sim_; }
+  const Simulation& simulation() const { return sim_; }
+  double d50() const { return d50_; }
+  // Consolidates to an isotropic stress p until stress and unbalanced force meet the tolerances.
+  long consolidate(double pressure, const std::string& phase);
+  EquilibriumState equilibriumState() const;
+  Record measure(double h0, double v0, const Vec3& l0, double strainRate) const;
+
+ private:
+  RunConfig config_;
+  ProgressFn progress_;
+  Simulation sim_;
+  double d50_ = 0.0;
+  void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
+  double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
+};
+
+// Sets up the contact model, damping, servo and time step of a simulation from the config.
+// Throws InputError when an explicit solver.dt exceeds the critical time step (unless forced).
+void configureSolver(const RunConfig& config, Simulation& sim);
+
+}  // namespace grainlab::lab

@@ -1,0 +1,79 @@
+#pragma once
+// The full description of a laboratory run. Every field has a default; io/config.cpp fills it from
+// TOML and validates it, and writes it back out with every default resolved. Units SI, angles deg.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlab::lab {
+
+struct GradingConfig {
+  std::string type = "curve";  // "curve" (percent passing by mass), "uniform" (by number), "list"
+  std::vector<double> diameters{2.0e-3, 8.0e-3};  // [m] (curve)
+  std::vector<double> passing{0.0, 100.0};        // [%] by mass (curve)
+  double dMin = 2.0e-3;                           // [m] (uniform)
+  double dMax = 8.0e-3;                           // [m] (uniform)
+  std::string file;                               // (list) one diameter [m] per line/row
+};
+
+struct SampleConfig {
+  int nParticles = 2000;
+  GradingConfig grading;
+  double density = 2600.0;   // [kg/m^3]
+  double e0 = 0.60;          // target initial void ratio
+  std::uint64_t seed = 1;
+  // Friction during compaction [deg]; lower gives a denser sample. Unset: searched to meet e0.
+  std::optional<double> prepFrictionDeg;
+  double e0Tolerance = 0.01;
+  double initialVoidRatio = 2.0;  // of the loose random placement before compaction
+};
+
+struct ContactConfig {
+  std::string model = "kozicki";
+  double young = 30.0e9;        // Ec [Pa]
+  double poisson = 0.3;         // nu_c [-]
+  double frictionDeg = 30.0;    // mu [deg]
+  double beta = 0.15;           // rolling stiffness coefficient [-]
+  double eta = 1.0;             // moment limit coefficient [-]
+  double wallFrictionDeg = 0.0; // 0: smooth walls, as in [W]
+};
+
+struct TestConfig {
+  std::string type = "triaxial";      // "isotropic" | "triaxial"
+  std::string boundary = "walls";
+  double confiningPressure = 100.0e3; // [Pa]
+  std::optional<double> axialStrainRate = 0.5;  // [1/s]; nullopt = "auto"
+  double finalAxialStrain = 0.20;     // [-]
+};
+
+struct SolverConfig {
+  double damping = 0.3;        // Cundall local damping alpha [-]
+  double dtFactor = 0.5;       // fraction of the critical time step
+  std::optional<double> dt;    // explicit time step [s]; refused above critical unless forced
+  bool forceDt = false;
+  int threads = 2;
+  double unbalancedTolerance = 0.01;  // quasi-static threshold for the unbalanced-force ratio
+  double stressTolerance = 0.01;      // relative, for isotropic equilibrium
+  double servoGain = 0.2;
+  double servoIntegralSteps = 500.0;
+  double servoMaxSpeed = 0.5;  // [m/s]
+  double skinFraction = 0.2;   // Verlet skin as a fraction of the smallest radius
+  long maxSteps = 50'000'000;  // safety limit per phase
+};
+
+struct OutputConfig {
+  std::string dir = "runs/example";
+  double recordEveryStrain = 0.001;
+  bool plots = true;
+};
+
+struct RunConfig {
+  SampleConfig sample;
+  ContactConfig contact;
+  TestConfig test;
+  SolverConfig solver;
+  OutputConfig output;
+};
+
+}  // namespace grainlab::lab
