@@ -216,7 +216,7 @@ void Simulation::integrate() {
 #pragma omp for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     // Cundall local damping per component, against the sign of the current (mid-step) velocity.
-    Vec3 f = particles.force[i];
+    Vec3 f = particles.force[i] + particles.mass[i] * gravity;
     Vec3 t = particles.torque[i];
     Vec3 fd, td;
     for (int k = 0; k < 3; ++k) {

@@ -46,6 +46,7 @@ class Simulation {
   ServoSettings servo;
   EnergyLedger energy;
 
+  Vec3 gravity = Vec3::Zero();  // [m/s^2]; off in the triaxial tests of [W]
   double dt = 0.0;            // [s]
   double localDamping = 0.3;  // Cundall alpha [-]
   long stepCount = 0;

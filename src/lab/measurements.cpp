@@ -7,7 +7,7 @@ namespace grainlab::lab {
 double unbalancedForceRatio(const Simulation& sim) {
   const auto& P = sim.particles;
   double net = 0.0;
-  for (std::size_t i = 0; i < P.size(); ++i) net += P.force[i].norm();
+  for (std::size_t i = 0; i < P.size(); ++i) net += (P.force[i] + P.mass[i] * sim.gravity).norm();
   double contactSum = 0.0;
   std::size_t contacts = 0;
   const auto& nl = sim.neighbors;
