@@ -14,6 +14,8 @@ struct RunOptions {
 };
 // `grainlab run`: returns the exit code; throws InputError / SimulationError.
 int runLab(const RunOptions& options);
+// `grainlab check`: validates and prints the resolved config (TOML) on stdout.
+int checkConfig(const RunOptions& options);
 
 struct BenchOptions {
   std::string scene = "triaxial-iso";

@@ -28,6 +28,12 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("presets", "List the shipped presets");
 
+  cli::RunOptions check;
+  auto* checkCmd = app.add_subcommand("check", "Validate a config and print it with every default filled in");
+  checkCmd->add_option("config", check.config, "CONFIG.toml or preset:NAME")->required();
+  checkCmd->add_option("--set", check.overrides, "override a config key: KEY=VALUE (TOML value)")
+      ->allow_extra_args(false);
+
   cli::BenchOptions bench;
   auto* benchCmd = app.add_subcommand("bench", "Time a named scene (particle-steps per second)");
   benchCmd->add_option("scene", bench.scene, "scene name (triaxial-iso)")->capture_default_str();
@@ -49,6 +55,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (app.got_subcommand("bench")) return cli::runBench(bench);
+    if (app.got_subcommand("check")) return cli::checkConfig(check);
     return cli::runLab(run);
   } catch (const InputError& e) {
     std::fprintf(stderr, "grainlab: %s\n", e.what());

@@ -49,14 +49,23 @@ void makePlots(const fs::path& dir, bool quiet) {
     std::fprintf(stderr, "grainlab: warning: plotting failed (results are complete without plots)\n");
 }
 
-}  // namespace
-
-int runLab(const RunOptions& opt) {
+lab::RunConfig resolveConfig(const RunOptions& opt) {
   toml::table table = io::loadConfigTable(opt.config);
   for (const auto& s : opt.overrides) io::applyOverride(table, s);
   if (!opt.outDir.empty()) io::applyOverride(table, "output.dir=\"" + opt.outDir + "\"");
   if (opt.threads > 0) io::applyOverride(table, fmt::format("solver.threads={}", opt.threads));
-  const lab::RunConfig config = io::parseConfig(table);
+  return io::parseConfig(table);
+}
+
+}  // namespace
+
+int checkConfig(const RunOptions& opt) {
+  std::fputs(io::toTomlString(io::resolvedTable(resolveConfig(opt))).c_str(), stdout);
+  return 0;
+}
+
+int runLab(const RunOptions& opt) {
+  const lab::RunConfig config = resolveConfig(opt);
   omp_set_num_threads(config.solver.threads);
 
   const fs::path dir = config.output.dir;
@@ -80,8 +89,9 @@ int runLab(const RunOptions& opt) {
     progress.finish();
     const Simulation& sim = lab.simulation();
     summary["e0"] = finite(prep.e0, "e0");
-    summary["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance ||
-                                     config.sample.prepFrictionDeg.has_value();
+    // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
+    summary["e0_searched"] = !config.sample.prepFrictionDeg.has_value();
+    summary["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
     summary["prep_friction_deg"] = prep.prepFrictionDeg;
     json search = json::array();
     for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});

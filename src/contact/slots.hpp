@@ -56,8 +56,8 @@ inline SlipResult tangentialCoulomb(const Vec3& carriedShear, double ks, const V
   if (mag > limit) {
     r.shearForce = mag > 0.0 ? Vec3(trial * (limit / mag)) : Vec3::Zero();
     r.sliding = true;
-    // The elastic energy of the spring beyond the limit is lost in slip: (|Ft|^2 - |Fs|^2) / 2ks.
-    r.dissipation = ks > 0.0 ? 0.5 * (mag * mag - limit * limit) / ks : 0.0;
+    // Work of the limit force over the slip (|Ft| - |Fs|)/ks, as YADE's plasticDissipation.
+    r.dissipation = ks > 0.0 ? (mag - limit) * limit / ks : 0.0;
   }
   return r;
 }
@@ -79,7 +79,7 @@ inline MomentResult momentElasticPlastic(const Vec3& carriedMoment, double kr, c
   if (mag > limit) {
     r.moment = mag > 0.0 ? Vec3(trial * (limit / mag)) : Vec3::Zero();
     r.yielding = true;
-    r.dissipation = kr > 0.0 ? 0.5 * (mag * mag - limit * limit) / kr : 0.0;
+    r.dissipation = kr > 0.0 ? (mag - limit) * limit / kr : 0.0;  // limit moment x plastic rotation
   }
   return r;
 }

@@ -245,6 +245,10 @@ lab::RunConfig parseConfig(const toml::table& root) {
   c.sample.e0Tolerance = s.number("e0_tolerance", c.sample.e0Tolerance, 0.0, 1.0, true, false, "must be in (0, 1]");
   c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
                                        "must be in [1, 20] (loose placement before compaction)");
+  c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
+                                          "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
+  c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
+  c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
   s.finish();
 
   Section ct(root, "contact");
@@ -320,6 +324,9 @@ toml::table resolvedTable(const lab::RunConfig& c) {
       {"seed", static_cast<std::int64_t>(c.sample.seed)},
       {"e0_tolerance", c.sample.e0Tolerance},
       {"initial_void_ratio", c.sample.initialVoidRatio},
+      {"prep_stiffness_factor", c.sample.prepStiffnessFactor},
+      {"prep_damping", c.sample.prepDamping},
+      {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
   };
   if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
   else sample.insert("prep_friction_deg", "auto");

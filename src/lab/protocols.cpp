@@ -78,12 +78,36 @@ long Laboratory::consolidate(double pressure, const std::string& phase) {
 double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Simulation& out,
                                        long& steps) {
   sim_ = loose;
+  // Rearrangement during compaction is paced by the grains' inertial time d sqrt(rho/p), not by
+  // the contact stiffness; softer contacts allow a proportionally longer time step, so compaction
+  // runs at Ec * prep_stiffness_factor. The packing is then stiffened to Ec and re-equilibrated.
+  sim_.model.young = config_.contact.young * config_.sample.prepStiffnessFactor;
+  sim_.dt = config_.solver.dtFactor * sim_.criticalTimeStep();
+  sim_.localDamping = config_.sample.prepDamping;
   setFriction(muDeg);
   steps += consolidate(config_.test.confiningPressure, fmt::format("compaction (mu_prep {:.1f} deg)", muDeg));
-  setFriction(config_.contact.frictionDeg);
-  steps += consolidate(config_.test.confiningPressure, "equilibrium at full friction");
+  steps += rampStiffness();
+  configureSolver(config_, sim_);
+  steps += consolidate(config_.test.confiningPressure, "equilibrium at full stiffness and friction");
   out = sim_;
   return voidRatio(sim_);
+}
+
+long Laboratory::rampStiffness() {
+  // A sudden stiffening would multiply every contact force by 1/factor at once and blow the packing
+  // apart; a geometric ramp lets the wall servos follow as the overlaps shrink.
+  const double factor = config_.sample.prepStiffnessFactor;
+  if (factor >= 1.0) return 0;
+  const long rampSteps = config_.sample.prepRampSteps;
+  const double growth = std::pow(1.0 / factor, 1.0 / static_cast<double>(rampSteps));
+  const double dtFromYoung = sim_.dt * std::sqrt(sim_.model.young);  // dt scales as Ec^-1/2
+  for (long i = 0; i < rampSteps; ++i) {
+    sim_.model.young = std::min(config_.contact.young, sim_.model.young * growth);
+    sim_.dt = dtFromYoung / std::sqrt(sim_.model.young);
+    sim_.step();
+    if (progress_ && i % 1000 == 0) progress_("stiffness ramp", static_cast<double>(i) / rampSteps, i);
+  }
+  return rampSteps;
 }
 
 PreparationResult Laboratory::prepare() {

@@ -77,6 +77,7 @@ class Laboratory {
   Simulation sim_;
   double d50_ = 0.0;
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
+  long rampStiffness();
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
 };
 

@@ -27,6 +27,9 @@ struct SampleConfig {
   std::optional<double> prepFrictionDeg;
   double e0Tolerance = 0.01;
   double initialVoidRatio = 2.0;  // of the loose random placement before compaction
+  double prepStiffnessFactor = 0.01;  // contact stiffness during compaction, as a fraction of Ec
+  double prepDamping = 0.3;           // local damping during compaction
+  long prepRampSteps = 20000;         // steps of the geometric ramp from the soft to the full Ec
 };
 
 struct ContactConfig {

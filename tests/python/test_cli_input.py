@@ -1,0 +1,144 @@
+"""Bad input gets exit code 2 and one line on stderr naming the key, the value and what is allowed;
+the INTERFACE.md example is accepted as written."""
+import json
+import math
+import os
+import textwrap
+
+import pytest
+
+INTERFACE_EXAMPLE = textwrap.dedent("""\
+    [sample]
+    n_particles = 2000
+    grading = { type = "curve", diameters = [2.0e-3, 8.0e-3], passing = [0.0, 100.0] }   # percent passing by mass
+    density = 2600.0
+    e0 = 0.60                      # target initial void ratio
+    seed = 1
+
+    [contact]
+    model = "kozicki"              # [W]
+    young = 30.0e9                 # Ec
+    poisson = 0.3                  # nu_c
+    friction_deg = 30.0            # mu
+    beta = 0.15                    # rolling stiffness coefficient
+    eta = 1.0                      # moment limit coefficient
+
+    [test]
+    type = "triaxial"
+    boundary = "walls"
+    confining_pressure = 100.0e3
+    axial_strain_rate = 0.5        # 1/s
+    final_axial_strain = 0.20
+
+    [solver]
+    damping = 0.3                  # local (Cundall) damping
+    dt_factor = 0.5                # fraction of the critical time step
+    threads = 2
+
+    [output]
+    dir = "runs/example"
+    record_every_strain = 0.001
+    """)
+
+
+def write(tmp_path, text, name="c.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return str(path)
+
+
+def test_version_and_presets(grainlab):
+    assert "grainlab" in grainlab("--version", check=0).stdout
+    out = grainlab("presets", check=0).stdout
+    assert "quick-triaxial" in out
+
+
+def test_interface_example_is_accepted(grainlab, tmp_path):
+    out = grainlab("check", write(tmp_path, INTERFACE_EXAMPLE), check=0).stdout
+    assert "n_particles = 2000" in out
+    assert "axial_strain_rate = 0.5" in out
+    # Defaults are filled in.
+    assert "prep_friction_deg = 'auto'" in out
+
+
+def test_set_overrides_and_auto_rate(grainlab, tmp_path):
+    path = write(tmp_path, INTERFACE_EXAMPLE)
+    out = grainlab("check", path, "--set", "contact.beta=0", "--set", 'test.axial_strain_rate="auto"',
+                   "--set", "test.confining_pressure=300e3", check=0).stdout
+    assert "beta = 0.0" in out
+    assert "axial_strain_rate = 'auto'" in out
+    assert "confining_pressure = 300000.0" in out
+
+
+BAD = [
+    # (override, key named in the message, value named in the message)
+    ("sample.n_particle=10", "sample.n_particle", "10"),
+    ('sample.e0="dense"', "sample.e0", "dense"),
+    ("sample.e0=0", "sample.e0", "0"),
+    ("sample.e0=-0.2", "sample.e0", "-0.2"),
+    ("test.confining_pressure=-100e3", "test.confining_pressure", "-100000"),
+    ("contact.friction_deg=90", "contact.friction_deg", "90"),
+    ("contact.friction_deg=120", "contact.friction_deg", "120"),
+    ('test.type="shear-box"', "test.type", "shear-box"),
+    ('test.axial_strain_rate="fast"', "test.axial_strain_rate", "fast"),
+    ("solver.threads=0", "solver.threads", "0"),
+    ("solver.dt_factor=1.5", "solver.dt_factor", "1.5"),
+    ('sample.grading={ type = "uniform", d_min = 5e-3, d_max = 1e-3 }', "sample.grading.d_max", "0.001"),
+    ('sample.grading={ type = "curve", diameters = [2e-3, 8e-3], passing = [10.0, 100.0] }',
+     "sample.grading.passing", "10"),
+    ('sample.grading={ type = "sieve" }', "sample.grading.type", "sieve"),
+    ("extra.key=1", "extra", "key"),
+]
+
+
+@pytest.mark.parametrize("override,key,value", BAD)
+def test_bad_input_exit_2_names_key_and_value(grainlab, tmp_path, override, key, value):
+    proc = grainlab("check", write(tmp_path, INTERFACE_EXAMPLE), "--set", override, check=2)
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert key in lines[0] and value in lines[0], lines[0]
+    assert "allowed" in lines[0] or "must" in lines[0] or "unknown" in lines[0], lines[0]
+
+
+def test_unknown_preset_and_missing_file(grainlab, tmp_path):
+    proc = grainlab("run", "preset:nope", check=2)
+    assert "nope" in proc.stderr and "quick-triaxial" in proc.stderr
+    proc = grainlab("run", str(tmp_path / "missing.toml"), check=2)
+    assert "missing.toml" in proc.stderr
+
+
+def test_toml_syntax_error(grainlab, tmp_path):
+    proc = grainlab("check", write(tmp_path, "[sample\nn_particles = 3\n"), check=2)
+    assert "line 1" in proc.stderr
+
+
+def test_time_step_above_critical_is_refused(grainlab, tmp_path):
+    cfg = INTERFACE_EXAMPLE.replace("n_particles = 2000", "n_particles = 20")
+    cfg = cfg.replace("threads = 2", "threads = 2\ndt = 1.0e-3")
+    proc = grainlab("run", write(tmp_path, cfg), "--out", str(tmp_path / "out"), "--quiet", check=2)
+    assert "solver.dt" in proc.stderr and "0.001" in proc.stderr and "critical" in proc.stderr
+
+
+def test_numerical_blow_up_exit_1_without_nan(grainlab, tmp_path):
+    """A forced time step far above critical blows up: exit 1 naming the step and the particle,
+    and nothing non-finite is written."""
+    cfg = INTERFACE_EXAMPLE.replace("n_particles = 2000", "n_particles = 60")
+    cfg = cfg.replace("threads = 2", "threads = 2\ndt = 4.0e-6\nforce_dt = true")
+    cfg = cfg.replace("e0 = 0.60", "e0 = 0.60\nprep_friction_deg = 10.0")
+    out = tmp_path / "out"
+    proc = grainlab("run", write(tmp_path, cfg), "--out", str(out), "--quiet", check=1)
+    assert "step" in proc.stderr and "particle" in proc.stderr, proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed"
+    assert not (out / "timeseries.csv").exists()
+
+    def finite(x):
+        if isinstance(x, float):
+            return math.isfinite(x)
+        if isinstance(x, dict):
+            return all(finite(v) for v in x.values())
+        if isinstance(x, list):
+            return all(finite(v) for v in x)
+        return True
+    assert finite(summary)
+    assert not [f for f in os.listdir(out) if ".tmp" in f]
