@@ -90,7 +90,8 @@ inline ContactResponse applyLaw(const PairParams& p, const ContactKinematics& k,
   const double twist = k.meanSpinNormal * k.dt;
 
   const Vec3 vt = k.relativeVelocity - k.normal * k.normal.dot(k.relativeVelocity);
-  const Vec3 carriedShear = carryWithContact(h.shearForce, k.prevNormal, k.normal, twist);
+  const Quat frame = contactFrameRotation(k.prevNormal, k.normal, twist);
+  const Vec3 carriedShear = frame * h.shearForce;
   const SlipResult slip =
       tangentialCoulomb(carriedShear, p.ks, vt * k.dt, k.normal, fn, p.tanFriction);
   h.shearForce = slip.shearForce;
@@ -99,7 +100,7 @@ inline ContactResponse applyLaw(const PairParams& p, const ContactKinematics& k,
   if (p.kr > 0.0) {
     Vec3 dTheta = k.relativeSpin * k.dt;
     if (!p.twisting) dTheta = bendingPart(dTheta, k.normal);
-    Vec3 carriedMoment = carryWithContact(h.moment, k.prevNormal, k.normal, twist);
+    Vec3 carriedMoment = frame * h.moment;
     if (!p.twisting) carriedMoment = bendingPart(carriedMoment, k.normal);
     const MomentResult m = momentElasticPlastic(carriedMoment, p.kr, dTheta, p.momentLimitArm * fn);
     h.moment = m.moment;

@@ -231,8 +231,9 @@ void Simulation::integrate() {
     x[i] += v[i] * h;
     const double wNorm = w[i].norm();
     if (wNorm > 0.0) {
-      const Quat dq(Eigen::AngleAxisd(wNorm * h, w[i] / wNorm));
-      q[i] = (dq * q[i]).normalized();
+      // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
+      const Vec3 half = 0.5 * h * w[i];
+      q[i] = (Quat(1.0, half.x(), half.y(), half.z()) * q[i]).normalized();
       particles.rotationPath[i] += wNorm * h;
     }
     if (!xBuild.empty()) maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());

@@ -31,16 +31,19 @@ TEST(KozickiDonze, PairParametersFollowW) {
   EXPECT_DOUBLE_EQ(m.wallParams(rA, 0.0).kr, 0.0);
 }
 
-TEST(CarryWithContact, IsAnExactRotation) {
+TEST(ContactFrameRotation, IsARotationIntoTheNewTangentPlane) {
   const Vec3 n0 = Vec3::UnitZ();
   const Vec3 n1 = Vec3(0.3, -0.2, 1.0).normalized();
   const Vec3 fs(2.0, 1.0, 0.0);  // in the plane of n0
-  const Vec3 carried = carryWithContact(fs, n0, n1, 0.37);
+  const Vec3 carried = contactFrameRotation(n0, n1, 0.37) * fs;
   EXPECT_NEAR(carried.norm(), fs.norm(), 1e-12);
   EXPECT_NEAR(carried.dot(n1), 0.0, 1e-12);  // lies in the new tangent plane
-  // A pure twist of 90 degrees about z turns x into y.
-  const Vec3 t = carryWithContact(Vec3::UnitX(), n0, n0, 0.5 * kPi);
-  EXPECT_NEAR((t - Vec3::UnitY()).norm(), 0.0, 1e-12);
+  // The tilt part is the exact rotation taking n0 onto n1.
+  EXPECT_NEAR((contactFrameRotation(n0, n1, 0.0) * n0 - n1).norm(), 0.0, 1e-14);
+  // A twist of one step's size (1e-4 rad) about z turns x by that angle to O(theta^3).
+  const double theta = 1e-4;
+  const Vec3 t = contactFrameRotation(n0, n0, theta) * Vec3::UnitX();
+  EXPECT_NEAR((t - Vec3(std::cos(theta), std::sin(theta), 0.0)).norm(), 0.0, 1e-13);
 }
 
 TEST(TangentialSlot, ElasticThenCoulombSliding) {
