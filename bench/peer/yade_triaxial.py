@@ -4,6 +4,7 @@
 Usage:
     yade -n -x bench/peer/yade_triaxial.py PACKING OUT.csv [--no-moments] [--strain 0.02]
                                            [--rate 1.0] [--relax-steps 2000] [--wall-young 3e16]
+                                           [--servo-integral 0.01]
 
 PACKING: first line a '#' comment; second line the six wall planes xlo xhi ylo yhi zlo zhi [m];
 then one sphere per line: radius x y z [m] (the packing is assumed to be in equilibrium).
@@ -25,8 +26,12 @@ moment (momentRotationLaw=False on the wall material).
 
 Loading: TriaxialStressController keeps the four lateral walls (x, y) at sigma3 = 100 kPa; the two
 z platens move at constant, opposite speeds v = rate * H0 / 2 (engineering strain rate on the
-height H0 at the start of shear). Before shearing, all six walls are servo-controlled at 100 kPa
-for --relax-steps steps.
+height H0 at the start of shear). The controller is a proportional servo, so a wall moving at a
+steady speed lags by a steady stress error (~3 % at 1 /s); an outer integral loop on its goals
+(--servo-integral, per step) removes that offset. Before shearing, all six walls are
+servo-controlled at 100 kPa for --relax-steps steps (no integral loop, walls nearly at rest).
+Rate sensitivity: at 1 /s the frictional no-moment case is not fully quasi-static (phi about 3 deg
+higher than at 0.25 /s on packing400u); with moments the difference is below about 1 deg.
 
 CSV columns (compression / contraction positive, stresses in Pa):
     step, eps1, eps_v, sigma1, sigma3, phi_deg, Z, unbalanced
@@ -67,7 +72,7 @@ parser.add_argument('--relax-steps', type=int, default=2000,
 parser.add_argument('--record-every', type=float, default=5e-4,
                     help='axial strain between CSV rows [-]')
 parser.add_argument('--dt-factor', type=float, default=0.5, help='dt = factor * PWaveTimeStep()')
-parser.add_argument('--servo-integral', type=float, default=0.003,
+parser.add_argument('--servo-integral', type=float, default=0.01,
                     help='gain (per step) of the integral correction of the lateral stress goals; '
                          '0 = plain TriaxialStressController')
 parser.add_argument('--wall-young', type=float, default=None,
@@ -234,7 +239,8 @@ triax.wall_back_activated = False
 triax.wall_front_activated = False
 
 rows = []
-state = {'integral': [0.0, 0.0], 'next': 0.0, 'maxDev3': 0.0, 'sumDev3': 0.0, 'nDev3': 0, 'done': False}
+state = {'integral': [0.0, 0.0], 'next': 0.0, 'maxDevWall': 0.0, 'nWallOver2': 0, 'maxDev3': 0.0,
+         'sumDev3': 0.0, 'nDev3': 0}
 step0 = O.iter
 
 
@@ -268,16 +274,18 @@ def shearStep():
                 triax.goal1 = goal
             else:
                 triax.goal2 = goal
-    for k in range(4):                                   # servo quality on the lateral walls
-        dev = abs(s[k] - args.pressure) / args.pressure
-        state['maxDev3'] = max(state['maxDev3'], dev)
-    state['sumDev3'] += abs(0.25 * sum(s[:4]) - args.pressure) / args.pressure
+    # servo quality on the lateral walls (per wall, and for the recorded mean sigma3)
+    devWall = max(abs(s[k] - args.pressure) for k in range(4)) / args.pressure
+    dev3 = abs(0.25 * sum(s[:4]) - args.pressure) / args.pressure
+    state['maxDevWall'] = max(state['maxDevWall'], devWall)
+    state['nWallOver2'] += devWall > 0.02
+    state['maxDev3'] = max(state['maxDev3'], dev3)
+    state['sumDev3'] += dev3
     state['nDev3'] += 1
     if eps1 >= state['next'] - 1e-12:
         record(eps1)
         state['next'] += args.record_every
     if eps1 >= args.strain - 1e-12:
-        state['done'] = True
         O.pause()
 
 
@@ -298,6 +306,9 @@ print('YADE %s, moments=%s, n=%d spheres, dt=%.4e s, platen speed=%.4e m/s'
          vPlaten))
 print('shear: %d steps in %.1f s (%.0f steps/s); relaxation %d steps in %.1f s'
       % (nShear, tShear, nShear / max(tShear, 1e-9), args.relax_steps, tRelax))
-print('lateral servo: max |sigma_wall - p|/p = %.2f %%, mean |sigma3 - p|/p = %.3f %%'
-      % (100 * state['maxDev3'], 100 * state['sumDev3'] / max(state['nDev3'], 1)))
+nDev = max(state['nDev3'], 1)
+print('lateral servo (every step): mean sigma3 off by %.3f %% on average, %.2f %% at worst; single '
+      'walls off by %.2f %% at worst, by more than 2 %% in %.2f %% of the steps'
+      % (100 * state['sumDev3'] / nDev, 100 * state['maxDev3'], 100 * state['maxDevWall'],
+         100.0 * state['nWallOver2'] / nDev))
 print('wrote %s (%d rows)' % (args.out, len(rows)))
