@@ -74,7 +74,11 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
     while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
     while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
     if (hi - lo < 3) continue;
-    const double psi = dilatancyAngleDeg(slope(c.eps1, c.epsV, lo, hi));
+    const double rate = slope(c.eps1, c.epsV, lo, hi);
+    // sin psi = -r/(2 - r) is only defined while the lateral strain rate is extensional or small
+    // (r < 2); a sudden collapse (eps_v growing faster than 2 eps1) has no dilatancy angle.
+    if (rate >= 1.0) continue;
+    const double psi = dilatancyAngleDeg(rate);
     if (psi > m.psiMaxDeg) {
       m.psiMaxDeg = psi;
       m.eps1AtPsiMax = c.eps1[i];

@@ -15,8 +15,9 @@ struct TriaxialCurves {
 
 // Windows used, stated here and in the README:
 //  - residual / critical state: the last 20 % of the final axial strain, eps1 >= 0.8 eps1_final;
-//  - dilatancy rate: local least-squares slope d(eps_v)/d(eps1) over a centred window of
-//    +-dilatancyHalfWindow axial strain (default 0.005);
+//  - dilatancy rate: local least-squares slope r = d(eps_v)/d(eps1) over a centred window of
+//    +-dilatancyHalfWindow axial strain (default 0.005); windows with r >= 1 (sudden collapse,
+//    where sin psi = -r/(2 - r) leaves [-1, 1]) are skipped;
 //  - E and nu: least-squares slopes of q and eps_v on eps1 over eps1 <= elasticWindow (0.1 %),
 //    at least the first 3 records after the start; E50 the secant to half the peak q.
 struct MacroSettings {
