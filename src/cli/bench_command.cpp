@@ -5,11 +5,12 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "io/packing.hpp"
+#include "io/results.hpp"
 #include "lab/measurements.hpp"
 #include "lab/protocols.hpp"
 
@@ -38,32 +39,6 @@ fs::path cacheFile(const std::string& scene, int n) {
   return base / "grainlab" / fmt::format("{}-{}.txt", scene, n);
 }
 
-void saveSample(const fs::path& file, const Simulation& sim) {
-  fs::create_directories(file.parent_path());
-  std::ofstream out(file.string() + ".tmp");
-  out.precision(17);
-  for (const Wall& w : sim.box.walls) out << w.position << ' ';
-  out << '\n';
-  for (std::size_t i = 0; i < sim.particles.size(); ++i) {
-    const Vec3& x = sim.particles.position[i];
-    out << sim.particles.radius[i] << ' ' << x[0] << ' ' << x[1] << ' ' << x[2] << '\n';
-  }
-  out.close();
-  fs::rename(file.string() + ".tmp", file);
-}
-
-bool loadSample(const fs::path& file, double density, Simulation& sim) {
-  std::ifstream in(file);
-  if (!in) return false;
-  std::array<double, 6> walls{};
-  for (double& w : walls) in >> w;
-  sim.particles = Particles{};
-  double r, x, y, z;
-  while (in >> r >> x >> y >> z) sim.particles.addSphere(Vec3(x, y, z), r, density);
-  sim.box.setBounds(Vec3(walls[0], walls[2], walls[4]), Vec3(walls[1], walls[3], walls[5]));
-  return sim.particles.size() > 0;
-}
-
 }  // namespace
 
 int runBench(const BenchOptions& opt) {
@@ -77,12 +52,14 @@ int runBench(const BenchOptions& opt) {
 
   Simulation sim;
   omp_set_num_threads(std::max(2, opt.threads));  // preparation uses what is there
-  if (!loadSample(cache, config.sample.density, sim)) {
+  if (fs::exists(cache)) {
+    io::loadPacking(cache, config.sample.density, sim);
+  } else {
     if (!opt.json) fmt::print(stderr, "preparing the {}-particle sample (cached in {})\n", opt.particles, cache.string());
     lab::Laboratory lab(config);
     lab.prepare();
     sim = lab.simulation();
-    saveSample(cache, sim);
+    io::writeFileAtomic(cache, io::packingText(sim, "grainlab bench sample " + opt.scene));
   }
   lab::configureSolver(config, sim);
   for (Wall& w : sim.box.walls) {

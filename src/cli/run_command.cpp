@@ -11,6 +11,7 @@
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
 #include "io/config.hpp"
+#include "io/packing.hpp"
 #include "io/results.hpp"
 #include "lab/macro.hpp"
 #include "lab/protocols.hpp"
@@ -85,12 +86,23 @@ int runLab(const RunOptions& opt) {
     lab::Laboratory lab(config, [&](const std::string& phase, double f, long steps) {
       progress.update(phase, f, steps);
     });
-    const lab::PreparationResult prep = lab.prepare();
+    lab::PreparationResult prep;
+    if (config.sample.packing.empty()) {
+      prep = lab.prepare();
+    } else {
+      Simulation packed;
+      io::loadPacking(config.sample.packing, config.sample.density, packed);
+      prep = lab.adoptPacking(std::move(packed));
+    }
+    if (config.output.savePacking)
+      io::writeFileAtomic(dir / "packing.txt",
+                          io::packingText(lab.simulation(), fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}",
+                                                                        prep.e0, config.test.confiningPressure, config.sample.seed)));
     progress.finish();
     const Simulation& sim = lab.simulation();
     summary["e0"] = finite(prep.e0, "e0");
     // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
-    summary["e0_searched"] = !config.sample.prepFrictionDeg.has_value();
+    summary["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
     summary["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
     summary["prep_friction_deg"] = prep.prepFrictionDeg;
     json search = json::array();

@@ -245,6 +245,9 @@ lab::RunConfig parseConfig(const toml::table& root) {
   c.sample.e0Tolerance = s.number("e0_tolerance", c.sample.e0Tolerance, 0.0, 1.0, true, false, "must be in (0, 1]");
   c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
                                        "must be in [1, 20] (loose placement before compaction)");
+  c.sample.packing = s.string("packing", c.sample.packing, {});
+  if (!c.sample.packing.empty() && !std::filesystem::exists(c.sample.packing))
+    fail("sample.packing", "\"" + c.sample.packing + "\"", "file not found");
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
@@ -297,6 +300,7 @@ lab::RunConfig parseConfig(const toml::table& root) {
   if (c.output.dir.empty()) fail("output.dir", "\"\"", "must be a non-empty path");
   c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 0.0, 0.1, true, false, "must be in (0, 0.1]");
   c.output.plots = o.boolean("plots", c.output.plots);
+  c.output.savePacking = o.boolean("save_packing", c.output.savePacking);
   o.finish();
   return c;
 }
@@ -326,6 +330,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
       {"initial_void_ratio", c.sample.initialVoidRatio},
       {"prep_stiffness_factor", c.sample.prepStiffnessFactor},
       {"prep_damping", c.sample.prepDamping},
+      {"packing", c.sample.packing},
       {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
   };
   if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
@@ -354,7 +359,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   if (c.solver.dt) solver.insert("dt", *c.solver.dt);
   toml::table output{{"dir", c.output.dir},
                      {"record_every_strain", c.output.recordEveryStrain},
-                     {"plots", c.output.plots}};
+                     {"plots", c.output.plots},
+                     {"save_packing", c.output.savePacking}};
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
                      {"solver", solver}, {"output", output}};
 }

@@ -186,6 +186,21 @@ PreparationResult Laboratory::prepare() {
   return result;
 }
 
+PreparationResult Laboratory::adoptPacking(Simulation packed) {
+  PreparationResult result;
+  sim_ = std::move(packed);
+  std::vector<double> diameters(sim_.particles.size());
+  for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.radius[i];
+  result.grading = gradingStats(diameters);
+  d50_ = result.grading.d50;
+  configureSolver(config_, sim_);
+  result.steps = consolidate(config_.test.confiningPressure, "equilibrium of the given packing");
+  result.prepFrictionDeg = config_.contact.frictionDeg;
+  result.e0 = voidRatio(sim_);
+  result.state = equilibriumState();
+  return result;
+}
+
 Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate) const {
   Record r;
   r.step = sim_.stepCount;

@@ -59,6 +59,9 @@ class Laboratory {
   // Draws the grading, places particles loosely, compacts to the confining pressure with the
   // preparation friction (searched when not given) and re-equilibrates with friction restored.
   PreparationResult prepare();
+  // Starts from a given packing (particles and walls already in `packed`): equilibrium at full
+  // stiffness and friction at the confining pressure, no compaction and no e0 search.
+  PreparationResult adoptPacking(Simulation packed);
   // Drained triaxial compression of the prepared sample (platens at constant speed, lateral walls
   // servo-controlled at sigma3 = p) to the final axial strain.
   ShearResult shear();

@@ -27,6 +27,7 @@ struct SampleConfig {
   std::optional<double> prepFrictionDeg;
   double e0Tolerance = 0.01;
   double initialVoidRatio = 2.0;  // of the loose random placement before compaction
+  std::string packing;            // start from this packing file instead of preparing a sample
   double prepStiffnessFactor = 0.01;  // contact stiffness during compaction, as a fraction of Ec
   double prepDamping = 0.3;           // local damping during compaction
   long prepRampSteps = 20000;         // steps of the geometric ramp from the soft to the full Ec
@@ -69,6 +70,7 @@ struct OutputConfig {
   std::string dir = "runs/example";
   double recordEveryStrain = 0.001;
   bool plots = true;
+  bool savePacking = true;  // packing.txt of the prepared sample, reusable as sample.packing
 };
 
 struct RunConfig {
