@@ -253,11 +253,13 @@ ShearResult Laboratory::shear() {
       w.control = WallControl::Stress;
       w.targetStress = p;
     }
-  // Platens at constant speed: engineering axial strain rate on the initial height.
+  // Platens at constant speed: engineering axial strain rate on the initial height. The speed is
+  // ramped up linearly over a few servo integral times, so that the lateral servos can learn how
+  // fast their walls must move instead of lagging behind a sudden start.
+  const double platenSpeed = 0.5 * out.strainRate * h0;
+  const long rampSteps = std::max(1L, static_cast<long>(4.0 * config_.solver.servoIntegralSteps));
   box.lower(2).control = WallControl::Velocity;
-  box.lower(2).velocity = 0.5 * out.strainRate * h0;
   box.upper(2).control = WallControl::Velocity;
-  box.upper(2).velocity = -0.5 * out.strainRate * h0;
   sim_.particles.resetRotationReference();
   sim_.energy = EnergyLedger{};
 
@@ -268,6 +270,9 @@ ShearResult Laboratory::shear() {
   double nextRecord = std::min(every, 0.1 * every);
   const long startStep = sim_.stepCount;
   while (true) {
+    const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - startStep + 1) / rampSteps);
+    box.lower(2).velocity = ramp * platenSpeed;
+    box.upper(2).velocity = -ramp * platenSpeed;
     sim_.step();
     const double eps1 = (h0 - box.length(2)) / h0;
     const bool last = eps1 >= finalStrain;
