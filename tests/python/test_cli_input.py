@@ -142,3 +142,31 @@ def test_numerical_blow_up_exit_1_without_nan(grainlab, tmp_path):
         return True
     assert finite(summary)
     assert not [f for f in os.listdir(out) if ".tmp" in f]
+
+
+def test_packing_round_trip(grainlab, tmp_path):
+    """A prepared sample is saved as packing.txt and a run can start from it."""
+    cfg = INTERFACE_EXAMPLE.replace("n_particles = 2000", "n_particles = 80").replace(
+        'type = "triaxial"', 'type = "isotropic"').replace("e0 = 0.60", "e0 = 0.60\nprep_friction_deg = 10.0")
+    first = tmp_path / "first"
+    grainlab("run", write(tmp_path, cfg), "--out", str(first), "--quiet", "--set", "output.plots=false", check=0)
+    packing = first / "packing.txt"
+    lines = packing.read_text().splitlines()
+    assert lines[0].startswith("#") and len(lines[1].split()) == 6 and len(lines) == 2 + 80
+    second = tmp_path / "second"
+    grainlab("run", write(tmp_path, cfg), "--out", str(second), "--quiet", "--set", "output.plots=false",
+             "--set", f'sample.packing="{packing}"', check=0)
+    a = json.loads((first / "summary.json").read_text())
+    b = json.loads((second / "summary.json").read_text())
+    assert abs(a["e0"] - b["e0"]) < 2e-3
+    assert b["e0_searched"] is False
+
+
+def test_bad_packing_file(grainlab, tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("# comment\n0 1 0 1 0 1\n0.001 0.5 0.5\n")
+    proc = grainlab("check", write(tmp_path, INTERFACE_EXAMPLE), "--set", f'sample.packing="{tmp_path / "none.txt"}"', check=2)
+    assert "sample.packing" in proc.stderr and "not found" in proc.stderr
+    proc = grainlab("run", write(tmp_path, INTERFACE_EXAMPLE), "--out", str(tmp_path / "o"), "--quiet",
+                    "--set", f'sample.packing="{bad}"', check=2)
+    assert "sample.packing" in proc.stderr and "line 3" in proc.stderr

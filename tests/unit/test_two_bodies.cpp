@@ -1,6 +1,8 @@
 // Two-body cases through the whole engine (driver + kernels + integrator), against analytic values.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
 
 #include "test_helpers.hpp"
@@ -109,10 +111,11 @@ TEST(SphereOnWall, RestsUnderGravity) {
   const double R = 1e-3;
   sim.particles.addSphere(Vec3(0, 0, -0.01 + R + 1e-5), R, 2600.0);
   sim.gravity = Vec3(0, 0, -9.81);
-  sim.localDamping = 0.3;
+  sim.localDamping = 0.7;  // damping changes the approach, not the state of rest
   sim.initialise();
   sim.dt = 0.5 * sim.criticalTimeStep();
-  for (int i = 0; i < 300000; ++i) sim.step();
+  omp_set_num_threads(1);  // one sphere: threads would only add overhead
+  for (int i = 0; i < 60000; ++i) sim.step();
   const double m = sim.particles.mass[0];
   const Wall& bottom = sim.box.lower(2);
   EXPECT_NEAR(bottom.normalForce / (m * 9.81), 1.0, 1e-6);
