@@ -148,7 +148,7 @@ void NeighborList::build(const Particles& particles, const WallBox& box) {
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 6; ++k) {
       const Wall& w = box.walls[k];
-      const double gap = (x[i][w.axis] - w.position) * (w.side == 0 ? 1.0 : -1.0);
+      const double gap = w.distance(x[i]);
       if (gap < r[i] + skin) newWallKeys.push_back(pairKey(static_cast<std::uint32_t>(i), k));
     }
     wallStart[i + 1] = static_cast<std::uint32_t>(newWallKeys.size());

@@ -22,6 +22,9 @@ struct Wall {
   double contactStiffness = 0.0;  // sum of Kn of its contacts [N/m]
   int contacts = 0;
 
+  // Signed distance of a point from the plane, positive on the inside of the box [m].
+  double distance(const Vec3& x) const { return (x[axis] - position) * (side == 0 ? 1.0 : -1.0); }
+
   Vec3 inwardNormal() const {
     Vec3 n = Vec3::Zero();
     n[axis] = side == 0 ? 1.0 : -1.0;

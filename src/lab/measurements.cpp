@@ -40,7 +40,7 @@ Mat3 contactStress(const Simulation& sim) {
     const std::uint32_t i = nl.wallParticle[c];
     const Wall& wall = sim.box.walls[nl.wallIndex[c]];
     const Vec3 n = wall.inwardNormal();
-    const double gap = (x[i][wall.axis] - wall.position) * (wall.side == 0 ? 1.0 : -1.0);
+    const double gap = wall.distance(x[i]);
     const double overlap = r[i] - gap;
     const Vec3 toContact = -(r[i] - 0.5 * overlap) * n;  // x^c - x^p
     s -= sim.wallForce[c] * toContact.transpose();
@@ -90,7 +90,7 @@ double elasticEnergy(const Simulation& sim) {
     if (!nl.wallHistory[c].touching) continue;
     const std::uint32_t i = nl.wallParticle[c];
     const Wall& wall = sim.box.walls[nl.wallIndex[c]];
-    const double gap = (x[i][wall.axis] - wall.position) * (wall.side == 0 ? 1.0 : -1.0);
+    const double gap = wall.distance(x[i]);
     e += springs(sim.model.wallParams(r[i], wall.tanFriction), r[i] - gap, nl.wallHistory[c]);
   }
   return e;
