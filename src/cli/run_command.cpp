@@ -12,6 +12,7 @@
 #include "core/errors.hpp"
 #include "io/config.hpp"
 #include "io/packing.hpp"
+#include "io/vtk.hpp"
 #include "io/results.hpp"
 #include "lab/macro.hpp"
 #include "lab/protocols.hpp"
@@ -86,6 +87,9 @@ int runLab(const RunOptions& opt) {
     lab::Laboratory lab(config, [&](const std::string& phase, double f, long steps) {
       progress.update(phase, f, steps);
     });
+    io::VtkSeries vtk(dir / "vtk");
+    if (config.output.vtkEveryStrain > 0.0)
+      lab.onSnapshot([&](const Simulation& s, double eps1) { vtk.write(s, eps1); }, config.output.vtkEveryStrain);
     lab::PreparationResult prep;
     if (config.sample.packing.empty()) {
       prep = lab.prepare();
@@ -155,6 +159,7 @@ int runLab(const RunOptions& opt) {
         std::fprintf(stderr, "grainlab: warning: inertial number %.2e exceeds 1e-3 (not quasi-static)\n",
                      shear.inertialNumber);
     } else {
+      if (config.output.vtkEveryStrain > 0.0) vtk.write(sim, 0.0);
       records.push_back(lab.measure(sim.box.length(2), sim.box.volume(),
                                     Vec3(sim.box.length(0), sim.box.length(1), sim.box.length(2)), 0.0));
     }

@@ -301,6 +301,8 @@ lab::RunConfig parseConfig(const toml::table& root) {
   c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 0.0, 0.1, true, false, "must be in (0, 0.1]");
   c.output.plots = o.boolean("plots", c.output.plots);
   c.output.savePacking = o.boolean("save_packing", c.output.savePacking);
+  c.output.vtkEveryStrain = o.number("vtk_every_strain", c.output.vtkEveryStrain, 0.0, 1.0, false, false,
+                                     "must be in [0, 1] (0: no VTK snapshots)");
   o.finish();
   return c;
 }
@@ -360,7 +362,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   toml::table output{{"dir", c.output.dir},
                      {"record_every_strain", c.output.recordEveryStrain},
                      {"plots", c.output.plots},
-                     {"save_packing", c.output.savePacking}};
+                     {"save_packing", c.output.savePacking},
+                     {"vtk_every_strain", c.output.vtkEveryStrain}};
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
                      {"solver", solver}, {"output", output}};
 }

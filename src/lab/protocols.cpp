@@ -268,6 +268,8 @@ ShearResult Laboratory::shear() {
   out.records.push_back(measure(h0, v0, l0, out.strainRate));
   // Records are ten times denser below 1 % axial strain, where E and nu are measured.
   double nextRecord = std::min(every, 0.1 * every);
+  double nextSnapshot = snapshotEvery_;
+  if (snapshot_) snapshot_(sim_, 0.0);
   const long startStep = sim_.stepCount;
   while (true) {
     const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - startStep + 1) / rampSteps);
@@ -282,6 +284,10 @@ ShearResult Laboratory::shear() {
           {out.maxLateralDeviation, std::abs(r.sigma2 - p) / p, std::abs(r.sigma3 - p) / p});
       out.records.push_back(r);
       while (nextRecord <= eps1) nextRecord += eps1 < 0.01 ? 0.1 * every : every;
+    }
+    if (snapshot_ && snapshotEvery_ > 0.0 && (eps1 >= nextSnapshot || last)) {
+      snapshot_(sim_, eps1);
+      while (nextSnapshot <= eps1) nextSnapshot += snapshotEvery_;
     }
     if (progress_ && (sim_.stepCount - startStep) % 2000 == 0)
       progress_("triaxial shearing", std::min(1.0, eps1 / finalStrain), sim_.stepCount - startStep);

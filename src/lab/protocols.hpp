@@ -14,6 +14,8 @@ namespace grainlab::lab {
 
 // Called during long phases: phase name, fraction done in [0, 1], steps so far in the phase.
 using ProgressFn = std::function<void(const std::string& phase, double fraction, long steps)>;
+// Called for snapshots (e.g. VTK) during shearing, with the current axial strain.
+using SnapshotFn = std::function<void(const Simulation& sim, double eps1)>;
 
 // One row of the time series (PHYSICS.md §0 signs: compression positive, eps_v > 0 contraction).
 struct Record {
@@ -66,6 +68,12 @@ class Laboratory {
   // servo-controlled at sigma3 = p) to the final axial strain.
   ShearResult shear();
 
+  // Snapshots every `everyStrain` of axial strain during shearing (and at its start and end).
+  void onSnapshot(SnapshotFn fn, double everyStrain) {
+    snapshot_ = std::move(fn);
+    snapshotEvery_ = everyStrain;
+  }
+
   Simulation& simulation() { return sim_; }
   const Simulation& simulation() const { return sim_; }
   double d50() const { return d50_; }
@@ -77,6 +85,8 @@ class Laboratory {
  private:
   RunConfig config_;
   ProgressFn progress_;
+  SnapshotFn snapshot_;
+  double snapshotEvery_ = 0.0;
   Simulation sim_;
   double d50_ = 0.0;
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }

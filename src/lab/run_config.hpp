@@ -71,6 +71,7 @@ struct OutputConfig {
   double recordEveryStrain = 0.001;
   bool plots = true;
   bool savePacking = true;  // packing.txt of the prepared sample, reusable as sample.packing
+  double vtkEveryStrain = 0.01;  // ParaView snapshots during shearing; 0 = none
 };
 
 struct RunConfig {

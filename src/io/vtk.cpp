@@ -1,0 +1,171 @@
+#include "io/vtk.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cstdint>
+
+#include "io/results.hpp"
+
+namespace grainlab::io {
+
+namespace {
+
+// Accumulates the arrays of one VTK XML unstructured-grid piece (ASCII, readable by ParaView,
+// VTK and meshio).
+class VtuPiece {
+ public:
+  void points(const std::vector<Vec3>& p) { points_ = p; }
+  void cell(const std::vector<std::int64_t>& nodes, std::uint8_t vtkType) {
+    for (auto n : nodes) connectivity_.push_back(n);
+    offsets_.push_back(static_cast<std::int64_t>(connectivity_.size()));
+    types_.push_back(vtkType);
+  }
+  void pointScalar(const std::string& name, const std::vector<double>& v) { pointData_ += array(name, v, 1); }
+  void pointVector(const std::string& name, const std::vector<Vec3>& v) { pointData_ += array(name, flatten(v), 3); }
+  void cellScalar(const std::string& name, const std::vector<double>& v) { cellData_ += array(name, v, 1); }
+  void cellVector(const std::string& name, const std::vector<Vec3>& v) { cellData_ += array(name, flatten(v), 3); }
+
+  std::string text() const {
+    std::string s = "<?xml version=\"1.0\"?>\n"
+                    "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                    "<UnstructuredGrid>\n";
+    s += fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", points_.size(), types_.size());
+    s += "<PointData>\n" + pointData_ + "</PointData>\n<CellData>\n" + cellData_ + "</CellData>\n";
+    s += array("Points", flatten(points_), 3, "<Points>\n", "</Points>\n");
+    s += "<Cells>\n";
+    s += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n" + join(connectivity_) + "</DataArray>\n";
+    s += "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n" + join(offsets_) + "</DataArray>\n";
+    std::vector<std::int64_t> types(types_.begin(), types_.end());
+    s += "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n" + join(types) + "</DataArray>\n";
+    s += "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    return s;
+  }
+
+ private:
+  static std::vector<double> flatten(const std::vector<Vec3>& v) {
+    std::vector<double> out;
+    out.reserve(3 * v.size());
+    for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
+    return out;
+  }
+  static std::string join(const std::vector<std::int64_t>& v) {
+    std::string s;
+    for (auto x : v) s += fmt::format("{} ", x);
+    return s + "\n";
+  }
+  static std::string array(const std::string& name, const std::vector<double>& v, int components,
+                           const std::string& open = "", const std::string& close = "") {
+    std::string s = open + fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
+                                       name, components);
+    for (std::size_t i = 0; i < v.size(); ++i) s += fmt::format("{:.9g}{}", v[i], (i + 1) % components ? " " : "\n");
+    return s + "</DataArray>\n" + close;
+  }
+
+  std::vector<Vec3> points_;
+  std::vector<std::int64_t> connectivity_, offsets_;
+  std::vector<std::uint8_t> types_;
+  std::string pointData_, cellData_;
+};
+
+constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9;
+
+std::string pvd(const std::string& kind, const std::vector<double>& labels) {
+  std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    s += fmt::format("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}_{:04d}.vtu\"/>\n", labels[i], kind, i);
+  return s + "</Collection>\n</VTKFile>\n";
+}
+
+}  // namespace
+
+std::string particlesVtu(const Simulation& sim) {
+  const Particles& P = sim.particles;
+  const std::size_t n = P.size();
+  std::vector<double> contacts(n, 0.0), angle(n), path(n);
+  const auto& nl = sim.neighbors;
+  for (std::size_t p = 0; p < nl.pairA.size(); ++p)
+    if (nl.pairHistory[p].touching) {
+      contacts[nl.pairA[p]] += 1.0;
+      contacts[nl.pairB[p]] += 1.0;
+    }
+  for (std::size_t c = 0; c < nl.wallParticle.size(); ++c)
+    if (nl.wallHistory[c].touching) contacts[nl.wallParticle[c]] += 1.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    angle[i] = radToDeg(P.rotationAngle(i));
+    path[i] = radToDeg(P.rotationPath[i]);
+  }
+  VtuPiece v;
+  v.points(P.position);
+  for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, kVertex);
+  v.pointScalar("radius", P.radius);
+  v.pointVector("velocity", P.velocity);
+  v.pointVector("angular_velocity", P.angularVelocity);
+  v.pointScalar("rotation_deg", angle);
+  v.pointScalar("rotation_path_deg", path);
+  v.pointScalar("contacts", contacts);
+  return v.text();
+}
+
+std::string contactsVtu(const Simulation& sim) {
+  const auto& nl = sim.neighbors;
+  VtuPiece v;
+  v.points(sim.particles.position);
+  std::vector<double> fn, ft;
+  std::vector<Vec3> force, normal;
+  for (std::size_t p = 0; p < nl.pairA.size(); ++p) {
+    if (!nl.pairHistory[p].touching) continue;
+    const std::uint32_t a = nl.pairA[p], b = nl.pairB[p];
+    const Vec3 n = (sim.particles.position[b] - sim.particles.position[a]).normalized();
+    const Vec3& f = sim.pairForce[p];
+    v.cell({a, b}, kLine);
+    fn.push_back(f.dot(n));
+    ft.push_back((f - f.dot(n) * n).norm());
+    force.push_back(f);
+    normal.push_back(n);
+  }
+  v.cellScalar("normal_force", fn);
+  v.cellScalar("tangential_force", ft);
+  v.cellVector("force", force);
+  v.cellVector("normal", normal);
+  return v.text();
+}
+
+std::string wallsVtu(const Simulation& sim) {
+  const WallBox& box = sim.box;
+  const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
+  std::vector<Vec3> corners;
+  for (int k = 0; k < 8; ++k) corners.emplace_back(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]);
+  VtuPiece v;
+  v.points(corners);
+  std::vector<double> stress, force;
+  std::vector<Vec3> normals;
+  for (const Wall& w : box.walls) {
+    // The four corners with this wall's coordinate, in cyclic order around the face.
+    const int a = w.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    const int bit = w.side << a;
+    const std::array<int, 4> order{0, 1 << b, (1 << b) | (1 << c), 1 << c};
+    std::vector<std::int64_t> quad;
+    for (int o : order) quad.push_back(o | bit);
+    v.cell(quad, kQuad);
+    stress.push_back(box.wallStress(static_cast<int>(&w - box.walls.data())));
+    force.push_back(w.normalForce);
+    normals.push_back(w.inwardNormal());
+  }
+  v.cellScalar("normal_stress", stress);
+  v.cellScalar("normal_force", force);
+  v.cellVector("inward_normal", normals);
+  return v.text();
+}
+
+void VtkSeries::write(const Simulation& sim, double label) {
+  const std::size_t index = labels_.size();
+  writeFileAtomic(dir_ / fmt::format("particles_{:04d}.vtu", index), particlesVtu(sim));
+  writeFileAtomic(dir_ / fmt::format("contacts_{:04d}.vtu", index), contactsVtu(sim));
+  writeFileAtomic(dir_ / fmt::format("walls_{:04d}.vtu", index), wallsVtu(sim));
+  labels_.push_back(label);
+  for (const char* kind : {"particles", "contacts", "walls"})
+    writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvd(kind, labels_));
+}
+
+}  // namespace grainlab::io

@@ -1,0 +1,30 @@
+#pragma once
+// ParaView snapshots: VTK XML unstructured grids (.vtu) for particles, the contact network and the
+// walls, each indexed in time by a .pvd collection. Files are written whole and renamed.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/simulation.hpp"
+
+namespace grainlab::io {
+
+class VtkSeries {
+ public:
+  explicit VtkSeries(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  // Writes particles_NNNN.vtu, contacts_NNNN.vtu, walls_NNNN.vtu and updates the three .pvd files;
+  // `label` is the collection's time value (the axial strain during shearing).
+  void write(const Simulation& sim, double label);
+  std::size_t snapshots() const { return labels_.size(); }
+
+ private:
+  std::filesystem::path dir_;
+  std::vector<double> labels_;
+};
+
+// The three grids as text (exposed for tests).
+std::string particlesVtu(const Simulation& sim);
+std::string contactsVtu(const Simulation& sim);
+std::string wallsVtu(const Simulation& sim);
+
+}  // namespace grainlab::io
