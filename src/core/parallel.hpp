@@ -1,24 +1,33 @@
 #pragma once
-// Deterministic parallel reductions: each thread accumulates its static chunk, and the partial sums
-// are added in thread order. OpenMP's reduction clause combines partials in completion order, which
-// would make the last bits of a sum vary from run to run.
-#include <omp.h>
-
+// Deterministic parallel sums. The work is cut into fixed chunks; each chunk's partial sum is
+// stored under its chunk index and the partials are added in chunk order. The result is the same
+// for any thread count and any schedule, so loops whose iterations cost unequal amounts (touching
+// vs. non-touching pairs) can use dynamic scheduling without losing bit-reproducibility. (OpenMP's
+// reduction clause combines partials in completion order instead.)
+#include <algorithm>
+#include <cstddef>
 #include <vector>
 
 namespace grainlab {
 
-class ThreadPartials {
+class ChunkedSums {
  public:
-  explicit ThreadPartials(int terms) : terms_(terms), values_(omp_get_max_threads() * terms, 0.0) {}
-  double* of(int thread) { return &values_[static_cast<std::size_t>(thread) * terms_]; }
+  static constexpr std::size_t kChunk = 512;
+
+  ChunkedSums(std::size_t items, int terms)
+      : items_(items), terms_(terms), values_(chunks() * terms, 0.0) {}
+  std::size_t chunks() const { return (items_ + kChunk - 1) / kChunk; }
+  std::size_t begin(std::size_t chunk) const { return chunk * kChunk; }
+  std::size_t end(std::size_t chunk) const { return std::min(items_, (chunk + 1) * kChunk); }
+  double& at(std::size_t chunk, int term) { return values_[chunk * terms_ + term]; }
   double total(int term) const {
     double s = 0.0;
-    for (std::size_t t = 0; t < values_.size() / terms_; ++t) s += values_[t * terms_ + term];
+    for (std::size_t c = 0; c < values_.size() / terms_; ++c) s += values_[c * terms_ + term];
     return s;
   }
 
  private:
+  std::size_t items_;
   int terms_;
   std::vector<double> values_;
 };

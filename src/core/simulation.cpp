@@ -43,14 +43,16 @@ void Simulation::computeContacts() {
   const std::size_t nWall = neighbors.wallParticle.size();
   wallForce.resize(nWall);
   wallTorque.resize(nWall);
-  ThreadPartials dissipation(2);  // slip, rolling
+  // Slip and rolling dissipation, summed per fixed chunk (see parallel.hpp); pairs first, then
+  // wall contacts. Chunks are scheduled dynamically: only touching pairs run the contact law.
+  ChunkedSums pairSums(nPairs, 2), wallSums(nWall, 2);
 
 #pragma omp parallel
   {
-  double* partial = dissipation.of(omp_get_thread_num());
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::size_t chunk = 0; chunk < pairSums.chunks(); ++chunk) {
   double slip = 0.0, roll = 0.0;
-#pragma omp for schedule(static)
-  for (std::size_t p = 0; p < nPairs; ++p) {
+  for (std::size_t p = pairSums.begin(chunk); p < pairSums.end(chunk); ++p) {
     const std::uint32_t a = neighbors.pairA[p], b = neighbors.pairB[p];
     contact::ContactHistory& h = neighbors.pairHistory[p];
     const Vec3 branch = x[b] - x[a];
@@ -84,9 +86,14 @@ void Simulation::computeContacts() {
     slip += res.slipDissipation;
     roll += res.rollDissipation;
   }
+  pairSums.at(chunk, 0) = slip;
+  pairSums.at(chunk, 1) = roll;
+  }
 
-#pragma omp for schedule(static)
-  for (std::size_t c = 0; c < nWall; ++c) {
+#pragma omp for schedule(dynamic, 1)
+  for (std::size_t chunk = 0; chunk < wallSums.chunks(); ++chunk) {
+  double slip = 0.0, roll = 0.0;
+  for (std::size_t c = wallSums.begin(chunk); c < wallSums.end(chunk); ++c) {
     const std::uint32_t i = neighbors.wallParticle[c];
     const Wall& wall = box.walls[neighbors.wallIndex[c]];
     contact::ContactHistory& h = neighbors.wallHistory[c];
@@ -121,11 +128,12 @@ void Simulation::computeContacts() {
     slip += res.slipDissipation;
     roll += res.rollDissipation;
   }
-  partial[0] += slip;
-  partial[1] += roll;
+  wallSums.at(chunk, 0) = slip;
+  wallSums.at(chunk, 1) = roll;
   }
-  energy.slip += dissipation.total(0);
-  energy.rolling += dissipation.total(1);
+  }
+  energy.slip += pairSums.total(0) + wallSums.total(0);
+  energy.rolling += pairSums.total(1) + wallSums.total(1);
 }
 
 void Simulation::gatherForces() {
@@ -208,13 +216,12 @@ void Simulation::integrate() {
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   double maxDisp2 = 0.0;
   long badParticle = -1;
-  ThreadPartials dampingWork(1);
+  ChunkedSums dampingWork(n, 1);
 
-#pragma omp parallel reduction(max : maxDisp2)
-  {
-  double* partial = dampingWork.of(omp_get_thread_num());
-#pragma omp for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
+#pragma omp parallel for schedule(static) reduction(max : maxDisp2)
+  for (std::size_t chunk = 0; chunk < dampingWork.chunks(); ++chunk) {
+  double work = 0.0;
+  for (std::size_t i = dampingWork.begin(chunk); i < dampingWork.end(chunk); ++i) {
     // Cundall local damping per component, against the sign of the current (mid-step) velocity.
     Vec3 f = particles.force[i] + particles.mass[i] * gravity;
     Vec3 t = particles.torque[i];
@@ -227,7 +234,7 @@ void Simulation::integrate() {
     v[i] += (f + fd) * (h / particles.mass[i]);
     w[i] += (t + td) * (h / particles.inertia[i]);
     // Work of the damping forces over the step, with the mean of old and new velocities.
-    partial[0] += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
+    work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
     x[i] += v[i] * h;
     const double wNorm = w[i].norm();
     if (wNorm > 0.0) {
@@ -245,6 +252,7 @@ void Simulation::integrate() {
       if (badParticle < 0 || static_cast<long>(i) < badParticle) badParticle = static_cast<long>(i);
     }
   }
+  dampingWork.at(chunk, 0) = work;
   }
   energy.damping -= dampingWork.total(0);
   if (badParticle >= 0) {
