@@ -20,11 +20,6 @@ void Particles::addSphere(const Vec3& x, double r, double density) {
   rotationPath.push_back(0.0);
 }
 
-void Particles::clearAccumulators() {
-  for (auto& f : force) f.setZero();
-  for (auto& t : torque) t.setZero();
-}
-
 void Particles::resetRotationReference() {
   referenceOrientation = orientation;
   for (auto& p : rotationPath) p = 0.0;

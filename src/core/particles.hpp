@@ -25,7 +25,6 @@ struct Particles {
 
   std::size_t size() const { return position.size(); }
   void addSphere(const Vec3& x, double r, double density);
-  void clearAccumulators();
   // Starts the rotation record anew (e.g. at the start of shearing).
   void resetRotationReference();
   // Angle [rad] of the composed rotation of particle i since its reference orientation.

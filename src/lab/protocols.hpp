@@ -76,7 +76,6 @@ class Laboratory {
 
   Simulation& simulation() { return sim_; }
   const Simulation& simulation() const { return sim_; }
-  double d50() const { return d50_; }
   // Consolidates to an isotropic stress p until stress and unbalanced force meet the tolerances.
   long consolidate(double pressure, const std::string& phase);
   EquilibriumState equilibriumState() const;

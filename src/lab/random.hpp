@@ -12,7 +12,6 @@ class Rng {
   // Uniform in [0, 1) with 53 random bits.
   double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  std::uint64_t next() { return engine_(); }
 
  private:
   std::mt19937_64 engine_;
