@@ -17,6 +17,18 @@ int runLab(const RunOptions& options);
 // `grainlab check`: validates and prints the resolved config (TOML) on stdout.
 int checkConfig(const RunOptions& options);
 
+struct SweepOptions {
+  std::string config;
+  std::vector<std::string> vary;       // KEY=V1,V2,...
+  std::vector<std::string> overrides;  // --set applied to every case
+  std::string outDir;
+  int jobs = 2;
+  int threads = 0;  // per case; 0: from the config
+  bool quiet = false;
+};
+// `grainlab sweep`: exit 0 when every case completed, 1 when any failed.
+int runSweep(const SweepOptions& options);
+
 struct BenchOptions {
   std::string scene = "triaxial-iso";
   int particles = 2000;

@@ -28,6 +28,16 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("presets", "List the shipped presets");
 
+  cli::SweepOptions sweep;
+  auto* sweepCmd = app.add_subcommand("sweep", "Run a grid of overrides in parallel processes and compare them");
+  sweepCmd->add_option("config", sweep.config, "CONFIG.toml or preset:NAME")->required();
+  sweepCmd->add_option("--vary", sweep.vary, "KEY=V1,V2,... (repeat for a grid)")->required()->allow_extra_args(false);
+  sweepCmd->add_option("--set", sweep.overrides, "override applied to every case")->allow_extra_args(false);
+  sweepCmd->add_option("--jobs", sweep.jobs, "cases run at once")->capture_default_str();
+  sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: solver.threads)");
+  sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)");
+  sweepCmd->add_flag("--quiet", sweep.quiet, "no progress output");
+
   cli::RunOptions check;
   auto* checkCmd = app.add_subcommand("check", "Validate a config and print it with every default filled in");
   checkCmd->add_option("config", check.config, "CONFIG.toml or preset:NAME")->required();
@@ -55,6 +65,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (app.got_subcommand("bench")) return cli::runBench(bench);
+    if (app.got_subcommand("sweep")) return cli::runSweep(sweep);
     if (app.got_subcommand("check")) return cli::checkConfig(check);
     return cli::runLab(run);
   } catch (const InputError& e) {

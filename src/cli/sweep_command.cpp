@@ -1,0 +1,199 @@
+// `grainlab sweep`: a grid of config overrides run as parallel processes, then one comparison table
+// and overlay plots. A failed case is reported and does not stop the others.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/errors.hpp"
+#include "io/config.hpp"
+#include "io/results.hpp"
+
+extern char** environ;
+
+namespace grainlab::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Vary {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+// Splits "a,b,[c,d],{ e = 1, f = 2 }" at the commas outside brackets, braces and quotes.
+std::vector<std::string> splitTopLevel(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cur;
+  int depth = 0;
+  char quote = 0;
+  for (char c : s) {
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    } else if (c == ',' && depth == 0) {
+      out.push_back(cur);
+      cur.clear();
+      continue;
+    }
+    cur += c;
+  }
+  out.push_back(cur);
+  return out;
+}
+
+Vary parseVary(const std::string& spec) {
+  const auto eq = spec.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+    throw InputError(fmt::format("--vary {}: expected KEY=V1,V2,... e.g. contact.beta=0,0.15,1", spec));
+  Vary v{spec.substr(0, eq), splitTopLevel(spec.substr(eq + 1))};
+  for (const auto& value : v.values)
+    if (value.empty()) throw InputError(fmt::format("--vary {}: empty value in the list", spec));
+  return v;
+}
+
+// A folder name for one case: key=value pairs with anything unsafe replaced.
+std::string caseName(std::size_t index, const std::vector<std::pair<std::string, std::string>>& sets) {
+  std::string name = fmt::format("case{:03d}", index);
+  for (const auto& [k, v] : sets) {
+    std::string part = k.substr(k.rfind('.') + 1) + "=" + v;
+    for (char& c : part)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '=') c = '_';
+    name += "_" + part.substr(0, 40);
+  }
+  return name;
+}
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+int runSweep(const SweepOptions& opt) {
+  if (opt.vary.empty()) throw InputError("sweep: give at least one --vary KEY=V1,V2,...");
+  if (opt.jobs < 1) throw InputError(fmt::format("--jobs = {}: must be >= 1", opt.jobs));
+  std::vector<Vary> varies;
+  for (const auto& spec : opt.vary) varies.push_back(parseVary(spec));
+
+  // The grid: every combination, the last --vary changing fastest.
+  std::vector<std::vector<std::pair<std::string, std::string>>> cases{{}};
+  for (const auto& v : varies) {
+    std::vector<std::vector<std::pair<std::string, std::string>>> next;
+    for (const auto& c : cases)
+      for (const auto& value : v.values) {
+        auto extended = c;
+        extended.emplace_back(v.key, value);
+        next.push_back(std::move(extended));
+      }
+    cases = std::move(next);
+  }
+  // Every case is validated before any starts: bad input is exit 2 with the usual message.
+  for (const auto& c : cases) {
+    toml::table table = io::loadConfigTable(opt.config);
+    for (const auto& s : opt.overrides) io::applyOverride(table, s);
+    for (const auto& [k, v] : c) io::applyOverride(table, k + "=" + v);
+    io::parseConfig(table);
+  }
+  const fs::path out = opt.outDir.empty() ? fs::path("runs/sweep") : fs::path(opt.outDir);
+  fs::create_directories(out);
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+
+  struct Job {
+    std::string name;
+    int status = -1;
+  };
+  std::vector<Job> jobs(cases.size());
+  std::map<pid_t, std::size_t> running;
+  std::size_t next = 0, done = 0;
+  auto wait_one = [&] {
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, 0);
+    if (pid <= 0 || !running.count(pid)) return;
+    const std::size_t i = running[pid];
+    running.erase(pid);
+    jobs[i].status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    ++done;
+    if (!opt.quiet)
+      std::fprintf(stderr, "[%zu/%zu] %s: %s\n", done, cases.size(), jobs[i].name.c_str(),
+                   jobs[i].status == 0 ? "completed" : fmt::format("failed (exit {})", jobs[i].status).c_str());
+  };
+  while (done < cases.size()) {
+    while (next < cases.size() && running.size() < static_cast<std::size_t>(opt.jobs)) {
+      jobs[next].name = caseName(next, cases[next]);
+      std::vector<std::string> args{self, "run", opt.config, "--out", (out / jobs[next].name).string(), "--quiet"};
+      if (opt.threads > 0) args.insert(args.end(), {"--threads", std::to_string(opt.threads)});
+      for (const auto& s : opt.overrides) args.insert(args.end(), {"--set", s});
+      for (const auto& [k, v] : cases[next]) args.insert(args.end(), {"--set", k + "=" + v});
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      const fs::path log = out / (jobs[next].name + ".log");
+      posix_spawn_file_actions_t actions;
+      posix_spawn_file_actions_init(&actions);
+      posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+      pid_t pid = 0;
+      const int rc = ::posix_spawn(&pid, self.c_str(), &actions, nullptr, argv.data(), environ);
+      posix_spawn_file_actions_destroy(&actions);
+      if (rc != 0) throw std::runtime_error(fmt::format("sweep: cannot start {}: {}", self, std::strerror(rc)));
+      running[pid] = next++;
+    }
+    wait_one();
+  }
+
+  // The comparison table: one row per case, its overrides and its macro-parameters.
+  static const std::vector<std::string> columns{
+      "e0", "phi_peak_deg", "eps1_at_peak", "phi_res_deg", "psi_max_deg", "E_MPa", "E50_MPa", "nu",
+      "cs_q_over_p", "cs_void_ratio", "inertial_number", "steps", "wall_seconds"};
+  std::string csv = "case,status";
+  for (const auto& v : varies) csv += "," + csvField(v.key);
+  for (const auto& c : columns) csv += "," + c;
+  csv += "\n";
+  int failed = 0;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    nlohmann::json summary;
+    std::ifstream in(out / jobs[i].name / "summary.json");
+    if (in) in >> summary;
+    const std::string status = jobs[i].status == 0 ? "completed" : fmt::format("failed (exit {})", jobs[i].status);
+    failed += jobs[i].status != 0;
+    csv += csvField(jobs[i].name) + "," + csvField(status);
+    for (const auto& [k, v] : cases[i]) csv += "," + csvField(v);
+    for (const auto& c : columns) {
+      csv += ",";
+      if (jobs[i].status == 0 && summary.contains(c) && summary[c].is_number())
+        csv += fmt::format("{:.8g}", summary[c].get<double>());
+    }
+    csv += "\n";
+  }
+  io::writeFileAtomic(out / "sweep.csv", csv);
+  const fs::path script = fs::path(GRAINLAB_SOURCE_DIR) / "tools" / "plot_sweep.py";
+  if (fs::exists(script)) {
+    const std::string cmd = fmt::format("\"{}\" \"{}\" \"{}\" >/dev/null 2>&1", GRAINLAB_PYTHON, script.string(), out.string());
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "grainlab: warning: sweep plots failed\n");
+  }
+  if (!opt.quiet)
+    std::printf("%zu cases, %d failed; table in %s\n", cases.size(), failed, (out / "sweep.csv").c_str());
+  return failed == 0 ? 0 : 1;
+}
+
+}  // namespace grainlab::cli
