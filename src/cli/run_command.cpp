@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -56,7 +57,7 @@ lab::RunConfig resolveConfig(const RunOptions& opt) {
   for (const auto& s : opt.overrides) io::applyOverride(table, s);
   if (!opt.outDir.empty()) io::applyOverride(table, "output.dir=\"" + opt.outDir + "\"");
   if (opt.threads > 0) io::applyOverride(table, fmt::format("solver.threads={}", opt.threads));
-  return io::parseConfig(table);
+  return io::parseConfig(table, io::configBaseDir(opt.config));
 }
 
 }  // namespace
@@ -113,6 +114,14 @@ int runLab(const RunOptions& opt) {
     for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
     summary["prep_search"] = search;
     summary["grading"] = gradingJson(prep.grading);
+    if (config.contact.model == "rolling-linear") {
+      const auto& mu = sim.particles.rollingFriction;
+      double sum = 0.0;
+      for (double m : mu) sum += m;
+      summary["mu_r_mean"] = sum / static_cast<double>(mu.size());
+      summary["mu_r_min"] = *std::min_element(mu.begin(), mu.end());
+      summary["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
+    }
     summary["isotropic_state"] = equilibriumJson(prep.state);
     summary["dt"] = sim.dt;
     summary["dt_critical"] = sim.criticalTimeStep();

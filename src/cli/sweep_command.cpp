@@ -112,7 +112,7 @@ int runSweep(const SweepOptions& opt) {
     toml::table table = io::loadConfigTable(opt.config);
     for (const auto& s : opt.overrides) io::applyOverride(table, s);
     for (const auto& [k, v] : c) io::applyOverride(table, k + "=" + v);
-    io::parseConfig(table);
+    io::parseConfig(table, io::configBaseDir(opt.config));
   }
   const fs::path out = opt.outDir.empty() ? fs::path("runs/sweep") : fs::path(opt.outDir);
   fs::create_directories(out);

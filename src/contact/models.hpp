@@ -3,7 +3,7 @@
 // Parameters that depend on the pair (stiffnesses, limits) come from `pairParams`; the law maps
 // geometry x parameters x history to force and moment (YADE's Ip2 / Law2 split).
 #include <cmath>
-#include <variant>
+#include <algorithm>
 
 #include "contact/slots.hpp"
 #include "core/types.hpp"
@@ -49,36 +49,68 @@ struct PairParams {
   bool twisting;           // whether the moment slot acts on twisting too
 };
 
-// Kozicki–Donzé contact with moments ([W] §3, PHYSICS.md §3.1):
-// Kn = 2 Ec RA RB/(RA+RB), Ks = nu Kn, Kr = beta Ks RA RB, |M| <= eta (RA+RB)/2 |Fn|.
-// The moment is incremental from (omega_B - omega_A) dt, like YADE's useIncrementalForm.
-struct KozickiDonze {
-  double young = 30e9;   // Ec [Pa]
-  double poisson = 0.3;  // nu_c [-]
-  double tanFriction = std::tan(degToRad(30.0));
-  double beta = 0.15;    // [-]
-  double eta = 1.0;      // [-]
+// How the rolling friction of a contact follows from its two grains' (model of [R]).
+enum class CombineRule { Min, Mean, Harmonic };
 
-  PairParams pairParams(double rA, double rB) const {
+inline double combineRollingFriction(CombineRule rule, double a, double b) {
+  switch (rule) {
+    case CombineRule::Min: return std::min(a, b);
+    case CombineRule::Mean: return 0.5 * (a + b);
+    case CombineRule::Harmonic: return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0;
+  }
+  return std::min(a, b);
+}
+
+// Which rolling slot a sphere model uses. One enum for the whole run: the branch in pairParams is
+// the same for every contact (perfectly predicted), no per-contact dispatch through pointers.
+enum class RollingLaw {
+  // Kozicki–Donzé ([W] §3, PHYSICS.md §3.1): Kr = beta Ks RA RB, full relative rotation (bending
+  // and twisting), |M| <= eta (RA+RB)/2 |Fn|.
+  KozickiDonze,
+  // Linear rolling resistance ([R], PHYSICS.md §3.2): R = RA RB/(RA+RB), kr = Ks R^2, bending
+  // only, |Mr| <= mu_r |Fn| R with mu_r combined from the two grains' values.
+  Linear,
+};
+
+// Contact model for spheres: shared normal and tangential parts (Kn = 2 Ec RA RB/(RA+RB),
+// Ks = nu Kn, Coulomb friction) and one of the rolling slots. Moments are incremental from
+// (omega_B - omega_A) dt, like YADE's useIncrementalForm.
+struct SphereContactModel {
+  double young = 30e9;   // Ec [Pa]
+  double poisson = 0.3;  // nu_c = Ks/Kn [-]
+  double tanFriction = std::tan(degToRad(30.0));
+  RollingLaw rolling = RollingLaw::KozickiDonze;
+  double beta = 0.15;    // [-] (Kozicki–Donzé)
+  double eta = 1.0;      // [-] (Kozicki–Donzé)
+  CombineRule combine = CombineRule::Min;  // (Linear)
+
+  // muA, muB: the grains' rolling friction (Linear law only).
+  PairParams pairParams(double rA, double rB, double muA = 0.0, double muB = 0.0) const {
     const double kn = 2.0 * young * rA * rB / (rA + rB);
     const double ks = poisson * kn;
+    if (rolling == RollingLaw::Linear) {
+      const double rBar = rA * rB / (rA + rB);
+      return {kn, ks, ks * rBar * rBar, tanFriction, combineRollingFriction(combine, muA, muB) * rBar, false};
+    }
     return {kn, ks, beta * ks * rA * rB, tanFriction, eta * 0.5 * (rA + rB), true};
   }
-  // A sphere of radius r against a rigid wall (R_B -> infinity): Kn = 2 Ec r, Ks = nu Kn,
-  // Kr = beta Ks r^2. A smooth wall (tan = 0) carries no shear force and no moment; a frictional
-  // wall limits the moment by eta r (the (RA+RB)/2 arm has no finite limit for a plane).
-  PairParams wallParams(double r, double wallTanFriction) const {
+  // A sphere of radius r against a rigid wall (R_B -> infinity): Kn = 2 Ec r, Ks = nu Kn. A smooth
+  // wall (tan = 0, the default) carries no shear force and no moment. Against a frictional wall the
+  // rolling stiffness is the R_B -> infinity limit (beta Ks r^2, or Ks r^2 with R = r) and the limit
+  // arm eta r (the (RA+RB)/2 arm has no finite limit for a plane) or mu_r r.
+  PairParams wallParams(double r, double wallTanFriction, double mu = 0.0) const {
     const double kn = 2.0 * young * r;
     const double ks = poisson * kn;
-    const bool smooth = wallTanFriction <= 0.0;
-    return {kn, ks, smooth ? 0.0 : beta * ks * r * r, wallTanFriction, smooth ? 0.0 : eta * r,
-            true};
+    if (wallTanFriction <= 0.0) return {kn, ks, 0.0, 0.0, 0.0, true};
+    if (rolling == RollingLaw::Linear) return {kn, ks, ks * r * r, wallTanFriction, mu * r, false};
+    return {kn, ks, beta * ks * r * r, wallTanFriction, eta * r, true};
   }
   // Stiffest contact a sphere of radius r can have (against a wall), for the critical time step.
   double maxNormalStiffness(double r) const { return 2.0 * young * r; }
   double maxRotationalStiffness(double r) const {
     const double ks = poisson * 2.0 * young * r;
-    return ks * r * r + beta * ks * r * r;  // shear spring at arm r plus the rolling spring
+    const double kr = rolling == RollingLaw::Linear ? ks * r * r : beta * ks * r * r;
+    return ks * r * r + kr;  // shear spring at arm r plus the rolling spring
   }
 };
 
@@ -115,7 +147,5 @@ inline ContactResponse applyLaw(const PairParams& p, const ContactKinematics& k,
   return out;
 }
 
-// The set of contact models; resolved once per step with std::visit, never per contact.
-using ContactModel = std::variant<KozickiDonze>;
 
 }  // namespace grainlab::contact

@@ -16,6 +16,8 @@ void Particles::addSphere(const Vec3& x, double r, double density) {
   radius.push_back(r);
   mass.push_back(m);
   inertia.push_back(0.4 * m * r * r);
+  rollingFriction.push_back(0.0);
+  sphericity.push_back(1.0);
   referenceOrientation.push_back(Quat::Identity());
   rotationPath.push_back(0.0);
 }

@@ -19,6 +19,10 @@ struct Particles {
   std::vector<double> radius;   // [m]
   std::vector<double> mass;     // [kg]
   std::vector<double> inertia;  // [kg m^2], 2/5 m R^2 for spheres
+  // Per-grain contact properties ([R]): rolling friction mu_r [-] and the true sphericity it came
+  // from (1 where not given).
+  std::vector<double> rollingFriction;
+  std::vector<double> sphericity;
   // Cumulative-rotation record (PHYSICS.md §7.4): reference orientation and path integral of |w| dt.
   std::vector<Quat> referenceOrientation;
   std::vector<double> rotationPath;  // [rad]

@@ -36,6 +36,7 @@ void Simulation::computeContacts() {
   const auto& v = particles.velocity;
   const auto& w = particles.angularVelocity;
   const auto& rad = particles.radius;
+  const auto& muR = particles.rollingFriction;
   const std::size_t nPairs = neighbors.pairA.size();
   pairForce.resize(nPairs);
   pairTorqueA.resize(nPairs);
@@ -79,7 +80,7 @@ void Simulation::computeContacts() {
     k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
     k.dt = dt;
     const contact::ContactResponse res =
-        contact::applyLaw(model.pairParams(rad[a], rad[b]), k, h);
+        contact::applyLaw(model.pairParams(rad[a], rad[b], muR[a], muR[b]), k, h);
     pairForce[p] = res.force;
     pairTorqueA[p] = g.branchA.cross(-res.force) + res.moment;
     pairTorqueB[p] = g.branchB.cross(res.force) - res.moment;
@@ -122,7 +123,7 @@ void Simulation::computeContacts() {
     k.meanSpinNormal = 0.5 * w[i].dot(n);
     k.dt = dt;
     const contact::ContactResponse res =
-        contact::applyLaw(model.wallParams(rad[i], wall.tanFriction), k, h);
+        contact::applyLaw(model.wallParams(rad[i], wall.tanFriction, muR[i]), k, h);
     wallForce[c] = res.force;
     wallTorque[c] = g.branchB.cross(res.force) - res.moment;
     slip += res.slipDissipation;

@@ -42,7 +42,7 @@ class Simulation {
   Particles particles;
   WallBox box;
   NeighborList neighbors;
-  contact::KozickiDonze model;
+  contact::SphereContactModel model;
   ServoSettings servo;
   EnergyLedger energy;
 

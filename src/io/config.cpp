@@ -15,12 +15,24 @@
 
 namespace grainlab::io {
 
+using lab::SphericityConfig;
+
 namespace {
 
 std::string show(const toml::node& node) {
   std::ostringstream os;
   node.visit([&](const auto& v) { os << v; });
   return os.str();
+}
+
+// A relative path in a config names a file beside that config (for a preset: in presets/), or,
+// failing that, one relative to the working directory. Resolved paths are absolute, so the
+// resolved config stays valid wherever it is read.
+std::string resolvePath(const std::string& path, const std::string& baseDir) {
+  namespace fs = std::filesystem;
+  if (path.empty() || fs::path(path).is_absolute()) return path;
+  if (!baseDir.empty() && fs::exists(fs::path(baseDir) / path)) return fs::absolute(fs::path(baseDir) / path).string();
+  return fs::exists(path) ? fs::absolute(path).string() : path;
 }
 
 [[noreturn]] void fail(const std::string& key, const std::string& value, const std::string& allowed) {
@@ -108,7 +120,7 @@ class Section {
   std::set<std::string> used_;
 };
 
-lab::GradingConfig parseGrading(Section& s) {
+lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
   lab::GradingConfig g;
   const toml::node* node = s.raw("grading");
   if (!node) return g;
@@ -148,7 +160,7 @@ lab::GradingConfig parseGrading(Section& s) {
   } else if (g.type == "list") {
     const toml::node* f = get("file");
     if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
-    g.file = f->value<std::string>().value();
+    g.file = resolvePath(f->value<std::string>().value(), baseDir);
     if (!std::filesystem::exists(g.file)) fail(key + ".file", show(*f), "file not found");
   } else {
     fail(key + ".type", show(*type), "allowed: \"curve\", \"uniform\", \"list\"");
@@ -160,6 +172,11 @@ lab::GradingConfig parseGrading(Section& s) {
 }
 
 }  // namespace
+
+std::string configBaseDir(const std::string& source) {
+  if (source.rfind("preset:", 0) == 0) return (std::filesystem::path(GRAINLAB_SOURCE_DIR) / "presets").string();
+  return std::filesystem::absolute(source).parent_path().string();
+}
 
 toml::table loadConfigTable(const std::string& source) {
   try {
@@ -219,7 +236,7 @@ void applyOverride(toml::table& table, const std::string& assignment) {
   }
 }
 
-lab::RunConfig parseConfig(const toml::table& root) {
+lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) {
   static const std::vector<std::string> sections{"sample", "contact", "test", "solver", "output"};
   for (const auto& [k, v] : root) {
     const std::string key(k.str());
@@ -230,7 +247,7 @@ lab::RunConfig parseConfig(const toml::table& root) {
 
   Section s(root, "sample");
   c.sample.nParticles = static_cast<int>(s.integer("n_particles", c.sample.nParticles, 2, 50'000'000));
-  c.sample.grading = parseGrading(s);
+  c.sample.grading = parseGrading(s, baseDir);
   c.sample.density = s.number("density", c.sample.density, 0.0, 1e6, true, false, "must be > 0 [kg/m^3]");
   c.sample.e0 = s.number("e0", c.sample.e0, 0.0, 5.0, true, false, "must be > 0 and <= 5 (void ratio)");
   c.sample.seed = static_cast<std::uint64_t>(s.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
@@ -245,7 +262,7 @@ lab::RunConfig parseConfig(const toml::table& root) {
   c.sample.e0Tolerance = s.number("e0_tolerance", c.sample.e0Tolerance, 0.0, 1.0, true, false, "must be in (0, 1]");
   c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
                                        "must be in [1, 20] (loose placement before compaction)");
-  c.sample.packing = s.string("packing", c.sample.packing, {});
+  c.sample.packing = resolvePath(s.string("packing", c.sample.packing, {}), baseDir);
   if (!c.sample.packing.empty() && !std::filesystem::exists(c.sample.packing))
     fail("sample.packing", "\"" + c.sample.packing + "\"", "file not found");
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
@@ -255,13 +272,51 @@ lab::RunConfig parseConfig(const toml::table& root) {
   s.finish();
 
   Section ct(root, "contact");
-  c.contact.model = ct.string("model", c.contact.model, {"kozicki"});
+  c.contact.model = ct.string("model", c.contact.model, {"kozicki", "rolling-linear"});
   c.contact.young = ct.number("young", c.contact.young, 0.0, 1e15, true, false, "must be > 0 [Pa]");
   c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 1.0, false, false, "must be in [0, 1] (Ks = poisson * Kn)");
   c.contact.frictionDeg = ct.number("friction_deg", c.contact.frictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   c.contact.beta = ct.number("beta", c.contact.beta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.eta = ct.number("eta", c.contact.eta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.wallFrictionDeg = ct.number("wall_friction_deg", c.contact.wallFrictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
+  const bool linear = c.contact.model == "rolling-linear";
+  const toml::node* mu = ct.raw("rolling_friction");
+  const toml::node* sph = ct.raw("sphericity");
+  if (!linear && (mu || sph))
+    fail(ct.path(mu ? "rolling_friction" : "sphericity"), show(mu ? *mu : *sph),
+         "only used with contact.model = \"rolling-linear\"");
+  if (mu && sph) fail("contact.sphericity", show(*sph), "give either contact.rolling_friction or contact.sphericity, not both");
+  c.contact.rollingFriction = ct.number("rolling_friction", c.contact.rollingFriction, 0.0, 10.0, false, false, "must be in [0, 10] (mu_r)");
+  if (sph) {
+    const std::string key = "contact.sphericity";
+    if (!sph->is_table())
+      fail(key, show(*sph), "must be an inline table { file = \"...\", c = 0.1963, k = ..., combine = \"min\" }");
+    const toml::table& t = *sph->as_table();
+    SphericityConfig sc;
+    for (const auto& [k, v] : t) {
+      const std::string name(k.str());
+      if (name != "file" && name != "c" && name != "k" && name != "combine")
+        fail(key + "." + name, show(v), "unknown key; allowed: file, c, k, combine");
+    }
+    const toml::node* file = t.get("file");
+    if (!file || !file->is_string()) fail(key + ".file", file ? show(*file) : "(missing)", "a path to a CSV of sphericities is required");
+    sc.file = resolvePath(file->value<std::string>().value(), baseDir);
+    if (!std::filesystem::exists(sc.file)) fail(key + ".file", show(*file), "file not found");
+    if (const toml::node* cn = t.get("c")) {
+      if (!cn->is_number() || !(cn->value<double>().value() > 0.0)) fail(key + ".c", show(*cn), "must be a number > 0");
+      sc.c = cn->value<double>().value();
+    }
+    const toml::node* kn = t.get("k");
+    if (!kn) fail(key + ".k", "(missing)", "the exponent k of mu_r = c psi^k has no default and must be given");
+    if (!kn->is_number() || !std::isfinite(kn->value<double>().value())) fail(key + ".k", show(*kn), "must be a number");
+    sc.k = kn->value<double>().value();
+    if (const toml::node* cb = t.get("combine")) {
+      const std::string v = cb->is_string() ? cb->value<std::string>().value() : "";
+      if (v != "min" && v != "mean" && v != "harmonic") fail(key + ".combine", show(*cb), "allowed: \"min\", \"mean\", \"harmonic\"");
+      sc.combine = v;
+    }
+    c.contact.sphericity = sc;
+  }
   ct.finish();
 
   Section t(root, "test");
@@ -341,6 +396,14 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                       {"poisson", c.contact.poisson},   {"friction_deg", c.contact.frictionDeg},
                       {"beta", c.contact.beta},         {"eta", c.contact.eta},
                       {"wall_friction_deg", c.contact.wallFrictionDeg}};
+  if (c.contact.model == "rolling-linear") {
+    if (c.contact.sphericity) {
+      const auto& sc = *c.contact.sphericity;
+      contact.insert("sphericity", toml::table{{"file", sc.file}, {"c", sc.c}, {"k", sc.k}, {"combine", sc.combine}});
+    } else {
+      contact.insert("rolling_friction", c.contact.rollingFriction);
+    }
+  }
   toml::table test{{"type", c.test.type},
                    {"boundary", c.test.boundary},
                    {"confining_pressure", c.test.confiningPressure},

@@ -104,6 +104,8 @@ std::string particlesVtu(const Simulation& sim) {
   v.pointScalar("rotation_deg", angle);
   v.pointScalar("rotation_path_deg", path);
   v.pointScalar("contacts", contacts);
+  v.pointScalar("mu_r", P.rollingFriction);
+  v.pointScalar("sphericity", P.sphericity);
   return v.text();
 }
 

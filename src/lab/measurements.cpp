@@ -84,14 +84,16 @@ double elasticEnergy(const Simulation& sim) {
     if (!nl.pairHistory[p].touching) continue;
     const std::uint32_t a = nl.pairA[p], b = nl.pairB[p];
     const double overlap = r[a] + r[b] - (x[b] - x[a]).norm();
-    e += springs(sim.model.pairParams(r[a], r[b]), overlap, nl.pairHistory[p]);
+    const auto& mu = sim.particles.rollingFriction;
+    e += springs(sim.model.pairParams(r[a], r[b], mu[a], mu[b]), overlap, nl.pairHistory[p]);
   }
   for (std::size_t c = 0; c < nl.wallParticle.size(); ++c) {
     if (!nl.wallHistory[c].touching) continue;
     const std::uint32_t i = nl.wallParticle[c];
     const Wall& wall = sim.box.walls[nl.wallIndex[c]];
     const double gap = wall.distance(x[i]);
-    e += springs(sim.model.wallParams(r[i], wall.tanFriction), r[i] - gap, nl.wallHistory[c]);
+    e += springs(sim.model.wallParams(r[i], wall.tanFriction, sim.particles.rollingFriction[i]), r[i] - gap,
+                 nl.wallHistory[c]);
   }
   return e;
 }

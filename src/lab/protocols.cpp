@@ -9,6 +9,7 @@
 #include "lab/macro.hpp"
 #include "lab/measurements.hpp"
 #include "lab/placement.hpp"
+#include "lab/sphericity.hpp"
 
 namespace grainlab::lab {
 
@@ -17,6 +18,14 @@ void configureSolver(const RunConfig& c, Simulation& sim) {
   sim.model.poisson = c.contact.poisson;
   sim.model.beta = c.contact.beta;
   sim.model.eta = c.contact.eta;
+  sim.model.rolling = c.contact.model == "rolling-linear" ? contact::RollingLaw::Linear
+                                                          : contact::RollingLaw::KozickiDonze;
+  if (c.contact.sphericity) {
+    const std::string& rule = c.contact.sphericity->combine;
+    sim.model.combine = rule == "mean"       ? contact::CombineRule::Mean
+                        : rule == "harmonic" ? contact::CombineRule::Harmonic
+                                             : contact::CombineRule::Min;
+  }
   sim.model.tanFriction = std::tan(degToRad(c.contact.frictionDeg));
   for (Wall& w : sim.box.walls) w.tanFriction = std::tan(degToRad(c.contact.wallFrictionDeg));
   sim.localDamping = c.solver.damping;
@@ -110,6 +119,24 @@ long Laboratory::rampStiffness() {
   return rampSteps;
 }
 
+void assignRollingFriction(const RunConfig& c, Particles& particles) {
+  if (c.contact.model != "rolling-linear") return;
+  const std::size_t n = particles.size();
+  if (!c.contact.sphericity) {
+    particles.rollingFriction.assign(n, c.contact.rollingFriction);
+    particles.sphericity.assign(n, 1.0);
+    return;
+  }
+  const SphericityConfig& sc = *c.contact.sphericity;
+  const SphericityDistribution d = readSphericityFile(sc.file, "contact.sphericity.file");
+  // A stream of its own, so that giving grains a sphericity does not change the sample's grading.
+  Rng rng(c.sample.seed ^ 0x9e3779b97f4a7c15ull);
+  particles.sphericity = sampleSphericity(d, n, rng);
+  particles.rollingFriction.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    particles.rollingFriction[i] = rollingFrictionFromSphericity(particles.sphericity[i], sc.c, sc.k);
+}
+
 PreparationResult Laboratory::prepare() {
   PreparationResult result;
   Rng rng(config_.sample.seed);
@@ -119,6 +146,7 @@ PreparationResult Laboratory::prepare() {
   d50_ = result.grading.d50;
   placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng,
              sim_.particles, sim_.box);
+  assignRollingFriction(config_, sim_.particles);
   configureSolver(config_, sim_);
   const Simulation loose = sim_;
 
@@ -189,6 +217,7 @@ PreparationResult Laboratory::prepare() {
 PreparationResult Laboratory::adoptPacking(Simulation packed) {
   PreparationResult result;
   sim_ = std::move(packed);
+  assignRollingFriction(config_, sim_.particles);
   std::vector<double> diameters(sim_.particles.size());
   for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.radius[i];
   result.grading = gradingStats(diameters);

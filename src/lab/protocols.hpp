@@ -93,6 +93,10 @@ class Laboratory {
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
 };
 
+// Gives every grain its rolling friction (contact.model = "rolling-linear"): the uniform
+// contact.rolling_friction, or c psi^k with psi drawn from contact.sphericity (seeded).
+void assignRollingFriction(const RunConfig& config, Particles& particles);
+
 // Sets up the contact model, damping, servo and time step of a simulation from the config.
 // Throws InputError when an explicit solver.dt exceeds the critical time step (unless forced).
 void configureSolver(const RunConfig& config, Simulation& sim);

@@ -33,14 +33,24 @@ struct SampleConfig {
   long prepRampSteps = 20000;         // steps of the geometric ramp from the soft to the full Ec
 };
 
+struct SphericityConfig {
+  std::string file;          // CSV: column `sphericity`, or `bin_low,bin_high,frequency`
+  double c = 0.1963;         // mu_r = c psi^k ([R])
+  double k = 0.0;            // required, no default
+  std::string combine = "min";  // "min" | "mean" | "harmonic"
+};
+
 struct ContactConfig {
-  std::string model = "kozicki";
+  std::string model = "kozicki";  // "kozicki" [W] | "rolling-linear" [R]
   double young = 30.0e9;        // Ec [Pa]
   double poisson = 0.3;         // nu_c [-]
   double frictionDeg = 30.0;    // mu [deg]
   double beta = 0.15;           // rolling stiffness coefficient [-]
   double eta = 1.0;             // moment limit coefficient [-]
   double wallFrictionDeg = 0.0; // 0: smooth walls, as in [W]
+  // rolling-linear only: a uniform rolling friction, or per-grain values from sphericity.
+  double rollingFriction = 0.1;
+  std::optional<SphericityConfig> sphericity;
 };
 
 struct TestConfig {

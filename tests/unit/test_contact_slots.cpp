@@ -15,7 +15,7 @@ TEST(NormalSlot, LinearAndNoTension) {
 }
 
 TEST(KozickiDonze, PairParametersFollowW) {
-  KozickiDonze m;  // Ec 30 GPa, nu 0.3, beta 0.15, eta 1
+  SphereContactModel m;  // Ec 30 GPa, nu 0.3, beta 0.15, eta 1
   const double rA = 1e-3, rB = 3e-3;
   const PairParams p = m.pairParams(rA, rB);
   const double kn = 2.0 * 30e9 * rA * rB / (rA + rB);
@@ -85,7 +85,7 @@ TEST(MomentSlot, ElasticThenPlateau) {
 class LawMoment : public ::testing::TestWithParam<Vec3> {};
 
 TEST_P(LawMoment, GrowsAsKrThetaAndPlateaus) {
-  KozickiDonze model;
+  SphereContactModel model;
   const double rA = 2e-3, rB = 3e-3, overlap = 1e-6, dt = 1e-6;
   const PairParams p = model.pairParams(rA, rB);
   const double fn = p.kn * overlap;
@@ -105,7 +105,7 @@ TEST_P(LawMoment, GrowsAsKrThetaAndPlateaus) {
   }
   EXPECT_NEAR(h.moment.norm(), limit, 1e-12 * limit);  // reached the plateau
 
-  KozickiDonze noRolling = model;
+  SphereContactModel noRolling = model;
   noRolling.beta = 0.0;
   ContactHistory h0;
   h0.prevNormal = Vec3::UnitZ();

@@ -1,0 +1,103 @@
+#include "lab/sphericity.hpp"
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace grainlab::lab {
+
+namespace {
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string field;
+  while (std::getline(ss, field, ',')) {
+    const auto b = field.find_first_not_of(" \t\r");
+    const auto e = field.find_last_not_of(" \t\r");
+    out.push_back(b == std::string::npos ? "" : field.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+}  // namespace
+
+SphericityDistribution readSphericityFile(const std::string& path, const std::string& key) {
+  std::ifstream in(path);
+  auto fail = [&](int line, const std::string& what) {
+    return InputError(fmt::format("config error: {} = \"{}\": {}{}", key, path,
+                                  line > 0 ? fmt::format("line {}: ", line) : std::string(), what));
+  };
+  if (!in) throw fail(0, "cannot be read");
+  std::string line;
+  int lineNo = 0;
+  std::vector<std::string> header;
+  while (header.empty() && std::getline(in, line)) {
+    ++lineNo;
+    if (!line.empty() && line[0] != '#') header = splitCsv(line);
+  }
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  };
+  const int psiCol = column("sphericity");
+  const int lowCol = column("bin_low"), highCol = column("bin_high"), freqCol = column("frequency");
+  if (psiCol < 0 && (lowCol < 0 || highCol < 0 || freqCol < 0))
+    throw fail(lineNo, "expected a header with a column 'sphericity', or 'bin_low,bin_high,frequency'");
+  SphericityDistribution d;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r,") == std::string::npos) continue;
+    const std::vector<std::string> f = splitCsv(line);
+    auto number = [&](int col, const char* name) {
+      if (col >= static_cast<int>(f.size())) throw fail(lineNo, fmt::format("missing {}", name));
+      try {
+        std::size_t used = 0;
+        const double v = std::stod(f[col], &used);
+        if (used != f[col].size() || !std::isfinite(v)) throw std::invalid_argument("");
+        return v;
+      } catch (const std::exception&) {
+        throw fail(lineNo, fmt::format("{} \"{}\" is not a number", name, f[col]));
+      }
+    };
+    if (psiCol >= 0) {
+      const double psi = number(psiCol, "sphericity");
+      if (!(psi > 0.0)) throw fail(lineNo, fmt::format("sphericity {} must be > 0", psi));
+      d.values.push_back(psi);
+    } else {
+      const double lo = number(lowCol, "bin_low"), hi = number(highCol, "bin_high"), fr = number(freqCol, "frequency");
+      if (!(lo > 0.0) || !(hi > lo)) throw fail(lineNo, fmt::format("bin [{}, {}) must satisfy 0 < bin_low < bin_high", lo, hi));
+      if (fr < 0.0) throw fail(lineNo, fmt::format("frequency {} must be >= 0", fr));
+      d.binLow.push_back(lo);
+      d.binHigh.push_back(hi);
+      d.frequency.push_back(fr);
+    }
+  }
+  if (d.values.empty() && d.frequency.empty()) throw fail(0, "no data rows");
+  if (d.isHistogram() && std::accumulate(d.frequency.begin(), d.frequency.end(), 0.0) <= 0.0)
+    throw fail(0, "all frequencies are zero");
+  return d;
+}
+
+std::vector<double> sampleSphericity(const SphericityDistribution& d, std::size_t n, Rng& rng) {
+  std::vector<double> out(n);
+  if (!d.isHistogram()) {
+    for (auto& v : out) v = d.values[std::min(d.values.size() - 1, static_cast<std::size_t>(rng.uniform() * d.values.size()))];
+    return out;
+  }
+  std::vector<double> cumulative(d.frequency.size());
+  std::partial_sum(d.frequency.begin(), d.frequency.end(), cumulative.begin());
+  for (auto& v : out) {
+    const double u = rng.uniform() * cumulative.back();
+    std::size_t b = std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin();
+    b = std::min(b, cumulative.size() - 1);
+    v = rng.uniform(d.binLow[b], d.binHigh[b]);
+  }
+  return out;
+}
+
+}  // namespace grainlab::lab

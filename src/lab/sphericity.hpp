@@ -1,0 +1,34 @@
+#pragma once
+// Per-grain rolling friction from true sphericity ([R], PHYSICS.md §3.2): each grain draws its
+// sphericity psi from a measured distribution (a list of values or a histogram), seeded; psi is
+// capped at 1 and mu_r = c psi^k.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "lab/random.hpp"
+
+namespace grainlab::lab {
+
+struct SphericityDistribution {
+  std::vector<double> values;            // a list of measured sphericities, or
+  std::vector<double> binLow, binHigh;   // a histogram: bins [low, high) with
+  std::vector<double> frequency;         // their (relative or absolute) frequencies
+  bool isHistogram() const { return !frequency.empty(); }
+};
+
+// Reads a CSV with a header: one column `sphericity` (a list), or columns `bin_low,bin_high,frequency`
+// (a histogram). Throws InputError naming `key`, the file and the line for bad content.
+SphericityDistribution readSphericityFile(const std::string& path, const std::string& key);
+
+// Draws n sphericities: from a list, uniformly among its values (a bootstrap of the measurement);
+// from a histogram, a bin with probability proportional to its frequency, then uniformly inside.
+std::vector<double> sampleSphericity(const SphericityDistribution& d, std::size_t n, Rng& rng);
+
+// mu_r = c psi^k with psi capped at 1.
+inline double rollingFrictionFromSphericity(double psi, double c, double k) {
+  return c * std::pow(std::min(psi, 1.0), k);
+}
+
+}  // namespace grainlab::lab
