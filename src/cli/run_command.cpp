@@ -90,7 +90,14 @@ int runLab(const RunOptions& opt) {
     });
     io::VtkSeries vtk(dir / "vtk");
     if (config.output.vtkEveryStrain > 0.0)
-      lab.onSnapshot([&](const Simulation& s, double eps1) { vtk.write(s, eps1); }, config.output.vtkEveryStrain);
+      lab.onSnapshot(
+          [&](const Simulation& s, double eps1) {
+            const lab::GrainKinematics k = lab.currentKinematics();
+            vtk.write(s, eps1,
+                      {{{"local_shear_strain", k.localShearStrain}, {"in_band", k.inBand}},
+                       {{"displacement", k.displacement}}});
+          },
+          config.output.vtkEveryStrain);
     lab::PreparationResult prep;
     if (config.sample.packing.empty()) {
       prep = lab.prepare();
@@ -164,6 +171,12 @@ int runLab(const RunOptions& opt) {
       summary["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
       summary["final_axial_strain"] = records.back().eps1;
       summary["shear_steps"] = shear.steps;
+      // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
+      const lab::GrainKinematics k = lab.currentKinematics();
+      summary["rotation_mean_deg"] = k.rotationMeanDeg;
+      summary["rotation_band_mean_deg"] = k.rotationBandMeanDeg;
+      summary["rotation_outside_band_mean_deg"] = k.rotationOutsideMeanDeg;
+      summary["band_fraction"] = k.bandFraction;
       if (shear.inertialNumber > 1e-3)
         std::fprintf(stderr, "grainlab: warning: inertial number %.2e exceeds 1e-3 (not quasi-static)\n",
                      shear.inertialNumber);

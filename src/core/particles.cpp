@@ -18,11 +18,13 @@ void Particles::addSphere(const Vec3& x, double r, double density) {
   inertia.push_back(0.4 * m * r * r);
   rollingFriction.push_back(0.0);
   sphericity.push_back(1.0);
+  referencePosition.push_back(x);
   referenceOrientation.push_back(Quat::Identity());
   rotationPath.push_back(0.0);
 }
 
-void Particles::resetRotationReference() {
+void Particles::resetKinematicReference() {
+  referencePosition = position;
   referenceOrientation = orientation;
   for (auto& p : rotationPath) p = 0.0;
 }

@@ -23,14 +23,16 @@ struct Particles {
   // from (1 where not given).
   std::vector<double> rollingFriction;
   std::vector<double> sphericity;
-  // Cumulative-rotation record (PHYSICS.md §7.4): reference orientation and path integral of |w| dt.
+  // Kinematic record (PHYSICS.md §7.4): reference position and orientation, and the path integral
+  // of |w| dt since then.
+  std::vector<Vec3> referencePosition;
   std::vector<Quat> referenceOrientation;
   std::vector<double> rotationPath;  // [rad]
 
   std::size_t size() const { return position.size(); }
   void addSphere(const Vec3& x, double r, double density);
-  // Starts the rotation record anew (e.g. at the start of shearing).
-  void resetRotationReference();
+  // Starts the kinematic record anew (e.g. at the start of shearing).
+  void resetKinematicReference();
   // Angle [rad] of the composed rotation of particle i since its reference orientation.
   double rotationAngle(std::size_t i) const;
   double solidVolume() const;

@@ -28,13 +28,14 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records) {
   std::string s =
       "step,time,eps1,eps_v,sigma1,sigma2,sigma3,q,p,e,phi_deg,Z,unbalanced,eps2,eps3,"
       "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
-      "W_boundary,D_slip,D_roll,D_damping\n";
+      "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction\n";
   for (const auto& r : records) {
     const double values[] = {r.time, r.eps1, r.epsV, r.sigma1, r.sigma2, r.sigma3, r.q, r.p, r.e,
                              r.phiDeg, r.coordination, r.unbalanced, r.eps2, r.eps3,
                              r.inertialNumber, r.sigma1Contact, r.sigma2Contact, r.sigma3Contact,
                              r.kinetic, r.elastic, r.workBoundary, r.dissipSlip, r.dissipRoll,
-                             r.dissipDamping};
+                             r.dissipDamping, r.rotationMeanDeg, r.rotationBandMeanDeg,
+                             r.bandFraction};
     s += fmt::format("{}", r.step);
     for (double v : values) {
       if (!std::isfinite(v))

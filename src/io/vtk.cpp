@@ -79,7 +79,7 @@ std::string pvd(const std::string& kind, const std::vector<double>& labels) {
 
 }  // namespace
 
-std::string particlesVtu(const Simulation& sim) {
+std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   const Particles& P = sim.particles;
   const std::size_t n = P.size();
   std::vector<double> contacts(n, 0.0), angle(n), path(n);
@@ -106,6 +106,8 @@ std::string particlesVtu(const Simulation& sim) {
   v.pointScalar("contacts", contacts);
   v.pointScalar("mu_r", P.rollingFriction);
   v.pointScalar("sphericity", P.sphericity);
+  for (const auto& [name, values] : extra.scalars) v.pointScalar(name, values);
+  for (const auto& [name, values] : extra.vectors) v.pointVector(name, values);
   return v.text();
 }
 
@@ -160,9 +162,9 @@ std::string wallsVtu(const Simulation& sim) {
   return v.text();
 }
 
-void VtkSeries::write(const Simulation& sim, double label) {
+void VtkSeries::write(const Simulation& sim, double label, const PointFields& extra) {
   const std::size_t index = labels_.size();
-  writeFileAtomic(dir_ / fmt::format("particles_{:04d}.vtu", index), particlesVtu(sim));
+  writeFileAtomic(dir_ / fmt::format("particles_{:04d}.vtu", index), particlesVtu(sim, extra));
   writeFileAtomic(dir_ / fmt::format("contacts_{:04d}.vtu", index), contactsVtu(sim));
   writeFileAtomic(dir_ / fmt::format("walls_{:04d}.vtu", index), wallsVtu(sim));
   labels_.push_back(label);

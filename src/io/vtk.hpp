@@ -9,12 +9,18 @@
 
 namespace grainlab::io {
 
+// Extra per-particle fields computed outside the engine (e.g. kinematics).
+struct PointFields {
+  std::vector<std::pair<std::string, std::vector<double>>> scalars;
+  std::vector<std::pair<std::string, std::vector<Vec3>>> vectors;
+};
+
 class VtkSeries {
  public:
   explicit VtkSeries(std::filesystem::path dir) : dir_(std::move(dir)) {}
   // Writes particles_NNNN.vtu, contacts_NNNN.vtu, walls_NNNN.vtu and updates the three .pvd files;
   // `label` is the collection's time value (the axial strain during shearing).
-  void write(const Simulation& sim, double label);
+  void write(const Simulation& sim, double label, const PointFields& extra = {});
   std::size_t snapshots() const { return labels_.size(); }
 
  private:
@@ -23,7 +29,7 @@ class VtkSeries {
 };
 
 // The three grids as text (exposed for tests).
-std::string particlesVtu(const Simulation& sim);
+std::string particlesVtu(const Simulation& sim, const PointFields& extra = {});
 std::string contactsVtu(const Simulation& sim);
 std::string wallsVtu(const Simulation& sim);
 

@@ -230,6 +230,19 @@ PreparationResult Laboratory::adoptPacking(Simulation packed) {
   return result;
 }
 
+GrainKinematics Laboratory::currentKinematics() const {
+  // Before shearing the reference is the current state; lengths are those of the box then.
+  const Vec3 l0 = shearReference_ ? *shearReference_
+                                  : Vec3(sim_.box.length(0), sim_.box.length(1), sim_.box.length(2));
+  Mat3 boxStrain = Mat3::Zero();
+  for (int a = 0; a < 3; ++a) {
+    const double stretch = sim_.box.length(a) / l0[a];
+    boxStrain(a, a) = 0.5 * (stretch * stretch - 1.0);
+  }
+  return grainKinematics(sim_.particles, sim_.particles.referencePosition, boxStrain,
+                         kNeighbourhoodDiameters * d50_);
+}
+
 Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate) const {
   Record r;
   r.step = sim_.stepCount;
@@ -255,6 +268,10 @@ Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRa
   r.sigma1Contact = sc(2, 2);
   r.sigma2Contact = sc(0, 0);
   r.sigma3Contact = sc(1, 1);
+  const GrainKinematics k = currentKinematics();
+  r.rotationMeanDeg = k.rotationMeanDeg;
+  r.rotationBandMeanDeg = k.rotationBandMeanDeg;
+  r.bandFraction = k.bandFraction;
   r.kinetic = kineticEnergy(sim_);
   r.elastic = elasticEnergy(sim_);
   r.workBoundary = sim_.energy.boundaryWork;
@@ -289,7 +306,8 @@ ShearResult Laboratory::shear() {
   const long rampSteps = std::max(1L, static_cast<long>(4.0 * config_.solver.servoIntegralSteps));
   box.lower(2).control = WallControl::Velocity;
   box.upper(2).control = WallControl::Velocity;
-  sim_.particles.resetRotationReference();
+  sim_.particles.resetKinematicReference();
+  shearReference_ = l0;
   sim_.energy = EnergyLedger{};
 
   const double finalStrain = config_.test.finalAxialStrain;

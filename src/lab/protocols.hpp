@@ -3,11 +3,13 @@
 // preparation friction (searched to meet a target e0), isotropic compression to the confining
 // pressure, and drained triaxial compression.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/simulation.hpp"
 #include "lab/grading.hpp"
+#include "lab/kinematics.hpp"
 #include "lab/run_config.hpp"
 
 namespace grainlab::lab {
@@ -26,6 +28,7 @@ struct Record {
   double q = 0.0, p = 0.0, e = 0.0, phiDeg = 0.0;
   double coordination = 0.0, unbalanced = 0.0, inertialNumber = 0.0;
   double sigma1Contact = 0.0, sigma2Contact = 0.0, sigma3Contact = 0.0;
+  double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
          dissipDamping = 0.0;
 };
@@ -79,6 +82,10 @@ class Laboratory {
   // Consolidates to an isotropic stress p until stress and unbalanced force meet the tolerances.
   long consolidate(double pressure, const std::string& phase);
   EquilibriumState equilibriumState() const;
+  // Grain displacement, rotation, local strain and shear band since the start of shearing; the
+  // neighbourhood of the local strain is kNeighbourhoodDiameters * d50.
+  GrainKinematics currentKinematics() const;
+  static constexpr double kNeighbourhoodDiameters = 2.0;
   Record measure(double h0, double v0, const Vec3& l0, double strainRate) const;
 
  private:
@@ -88,6 +95,7 @@ class Laboratory {
   double snapshotEvery_ = 0.0;
   Simulation sim_;
   double d50_ = 0.0;
+  std::optional<Vec3> shearReference_;  // box lengths at the start of shearing
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);

@@ -1,0 +1,37 @@
+#pragma once
+// Grain kinematics since a reference state (PHYSICS.md §7.4): displacement, rotation, local strain
+// and the shear band.
+//
+// Local strain: for each grain, the displacement gradient G that best maps the reference
+// branch vectors to its neighbours (reference distance <= neighbourhood radius) onto their relative
+// displacements, in the least-squares sense; F = I + G, Green–Lagrange E = (F^T F - I)/2 (zero for
+// any rigid motion), and the equivalent shear strain eq = sqrt(2/3 e:e) of its deviator e.
+// A grain is in the shear band when its eq is at least `bandFactor` times the eq of the box's own
+// (homogeneous) strain: localisation means grains deforming well above the average.
+#include <vector>
+
+#include "core/particles.hpp"
+
+namespace grainlab::lab {
+
+struct GrainKinematics {
+  std::vector<Vec3> displacement;       // [m]
+  std::vector<double> rotationDeg;      // angle of the composed rotation since the reference [deg]
+  std::vector<double> localShearStrain; // eq of the local Green–Lagrange strain [-]
+  std::vector<double> inBand;           // 1 in the band, 0 outside
+  double boxShearStrain = 0.0;
+  double rotationMeanDeg = 0.0;
+  double rotationBandMeanDeg = 0.0;     // 0 when no grain is in the band
+  double rotationOutsideMeanDeg = 0.0;
+  double bandFraction = 0.0;
+};
+
+// Equivalent shear strain sqrt(2/3 e:e) of the deviator of a strain tensor.
+double equivalentShearStrain(const Mat3& strain);
+
+// `boxStrain`: the box's homogeneous Green–Lagrange strain (diagonal for a wall box);
+// `radius`: neighbourhood radius [m]; `bandFactor`: threshold on eq / eq_box.
+GrainKinematics grainKinematics(const Particles& particles, const std::vector<Vec3>& referencePosition,
+                                const Mat3& boxStrain, double radius, double bandFactor = 2.0);
+
+}  // namespace grainlab::lab
