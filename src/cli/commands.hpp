@@ -14,6 +14,13 @@ struct RunOptions {
 };
 // `grainlab run`: returns the exit code; throws InputError / SimulationError.
 int runLab(const RunOptions& options);
+struct ResumeOptions {
+  std::string dir;
+  bool quiet = false;
+};
+// `grainlab resume DIR`: continues an interrupted run from its checkpoint.
+int resumeLab(const ResumeOptions& options);
+
 // `grainlab check`: validates and prints the resolved config (TOML) on stdout.
 int checkConfig(const RunOptions& options);
 

@@ -28,6 +28,11 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("presets", "List the shipped presets");
 
+  cli::ResumeOptions resume;
+  auto* resumeCmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
+  resumeCmd->add_option("dir", resume.dir, "results folder of the run")->required();
+  resumeCmd->add_flag("--quiet", resume.quiet, "no progress output");
+
   cli::SweepOptions sweep;
   auto* sweepCmd = app.add_subcommand("sweep", "Run a grid of overrides in parallel processes and compare them");
   sweepCmd->add_option("config", sweep.config, "CONFIG.toml or preset:NAME")->required();
@@ -67,6 +72,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("bench")) return cli::runBench(bench);
     if (app.got_subcommand("sweep")) return cli::runSweep(sweep);
     if (app.got_subcommand("check")) return cli::checkConfig(check);
+    if (app.got_subcommand("resume")) return cli::resumeLab(resume);
     return cli::runLab(run);
   } catch (const InputError& e) {
     std::fprintf(stderr, "grainlab: %s\n", e.what());

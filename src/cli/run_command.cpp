@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -67,16 +69,172 @@ int checkConfig(const RunOptions& opt) {
   return 0;
 }
 
+namespace {
+
+// The part of a run after the sample exists: shearing (resumable), results, plots. Shared by
+// `run` and `resume`; `summary` already holds what preparation reported.
+class RunSession {
+ public:
+  RunSession(const lab::RunConfig& config, fs::path dir, bool quiet, json summary, double secondsBefore,
+             std::vector<double> vtkLabels = {})
+      : config_(config), dir_(std::move(dir)), quiet_(quiet), progress_(quiet),
+        summary_(std::move(summary)), secondsBefore_(secondsBefore), t0_(std::chrono::steady_clock::now()),
+        vtk_(dir_ / "vtk", std::move(vtkLabels)),
+        lab_(config, [this](const std::string& phase, double f, long steps) { progress_.update(phase, f, steps); }) {
+    if (config.output.vtkEveryStrain > 0.0)
+      lab_.onSnapshot(
+          [this](const Simulation& s, double eps1) {
+            const lab::GrainKinematics k = lab_.currentKinematics();
+            vtk_.write(s, eps1,
+                       {{{"local_shear_strain", k.localShearStrain}, {"in_band", k.inBand}},
+                        {{"displacement", k.displacement}}});
+          },
+          config.output.vtkEveryStrain);
+    if (config.output.checkpointEvery > 0.0)
+      lab_.onCheckpoint([this](const lab::Laboratory&) { writeCheckpoint(); }, config.output.checkpointEvery);
+  }
+
+  lab::Laboratory& lab() { return lab_; }
+  json& summary() { return summary_; }
+  ProgressLine& progress() { return progress_; }
+  io::VtkSeries& vtk() { return vtk_; }
+  double seconds() const {
+    return secondsBefore_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+  }
+
+  // checkpoint/state.bin: a JSON header line (summary so far, VTK snapshot times, wall time) and the
+  // exact binary state, written as one file and renamed into place.
+  void writeCheckpoint() {
+    json header{{"format", "grainlab-checkpoint-1"}, {"version", GRAINLAB_VERSION}, {"summary", summary_},
+                {"vtk_labels", vtk_.labels()}, {"wall_seconds", seconds()}};
+    std::ostringstream out(std::ios::binary);
+    out << header.dump() << '\n';
+    lab_.saveState(out);
+    io::writeFileAtomic(dir_ / "checkpoint" / "state.bin", out.str());
+  }
+
+  // Shears (from the start, or from where a loaded checkpoint left off) and writes every result.
+  int finishTriaxial() {
+    if (!lab_.shearStarted()) {
+      lab_.beginShear();
+      if (config_.output.checkpointEvery > 0.0) writeCheckpoint();
+    }
+    lab::ShearResult shear = lab_.continueShear();
+    progress_.finish();
+    const std::vector<lab::Record>& records = shear.records;
+    lab::TriaxialCurves curves;
+    for (const auto& r : records) {
+      curves.eps1.push_back(r.eps1);
+      curves.epsV.push_back(r.epsV);
+      curves.sigma1.push_back(r.sigma1);
+      curves.sigma3.push_back(0.5 * (r.sigma2 + r.sigma3));
+      curves.voidRatio.push_back(r.e);
+    }
+    const lab::MacroParameters m = lab::computeMacro(curves);
+    summary_["phi_peak_deg"] = finite(m.phiPeakDeg, "phi_peak_deg");
+    summary_["eps1_at_peak"] = m.eps1AtPeak;
+    summary_["q_peak"] = m.qPeak;
+    summary_["phi_res_deg"] = finite(m.phiResDeg, "phi_res_deg");
+    summary_["residual_window_eps1"] = {m.residualFrom, records.back().eps1};
+    summary_["psi_max_deg"] = finite(m.psiMaxDeg, "psi_max_deg");
+    summary_["eps1_at_psi_max"] = m.eps1AtPsiMax;
+    summary_["E_MPa"] = finite(m.youngModulus / 1e6, "E_MPa");
+    summary_["E50_MPa"] = finite(m.e50 / 1e6, "E50_MPa");
+    summary_["nu"] = finite(m.poisson, "nu");
+    summary_["cs_q_over_p"] = m.csStressRatio;
+    summary_["cs_void_ratio"] = m.csVoidRatio;
+    summary_["strain_rate"] = shear.strainRate;
+    summary_["inertial_number"] = shear.inertialNumber;
+    summary_["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
+    summary_["final_axial_strain"] = records.back().eps1;
+    summary_["shear_steps"] = shear.steps;
+    // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
+    const lab::GrainKinematics k = lab_.currentKinematics();
+    summary_["rotation_mean_deg"] = k.rotationMeanDeg;
+    summary_["rotation_band_mean_deg"] = k.rotationBandMeanDeg;
+    summary_["rotation_outside_band_mean_deg"] = k.rotationOutsideMeanDeg;
+    summary_["band_fraction"] = k.bandFraction;
+    // I = rate d50 sqrt(rho/p) with the p measured at each record.
+    double inertialMax = 0.0;
+    for (const auto& r : records) inertialMax = std::max(inertialMax, r.inertialNumber);
+    summary_["inertial_number_max"] = inertialMax;
+    summary_["quasi_static"] = inertialMax <= 1e-3;
+    if (inertialMax > 1e-3)
+      std::fprintf(stderr, "grainlab: warning: inertial number reached %.2e > 1e-3: the test was not quasi-static\n",
+                   inertialMax);
+    return writeResults(records, summary_.value("preparation_steps", 0L) + shear.steps);
+  }
+
+  int finishIsotropic() {
+    const Simulation& sim = lab_.simulation();
+    if (config_.output.vtkEveryStrain > 0.0) vtk_.write(sim, 0.0);
+    const std::vector<lab::Record> records{lab_.measure(
+        sim.box.length(2), sim.box.volume(), Vec3(sim.box.length(0), sim.box.length(1), sim.box.length(2)), 0.0)};
+    return writeResults(records, summary_.value("preparation_steps", 0L));
+  }
+
+  // A failed run still leaves a summary saying so (and nothing non-finite).
+  void writeFailure(const std::string& what) {
+    progress_.finish();
+    summary_["status"] = "failed";
+    summary_["error"] = what;
+    summary_["wall_seconds"] = seconds();
+    io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
+  }
+
+ private:
+  int writeResults(const std::vector<lab::Record>& records, long steps) {
+    const double wall = seconds();
+    summary_["steps"] = steps;
+    summary_["wall_seconds"] = wall;
+    summary_["particle_steps_per_s"] = static_cast<double>(steps) * config_.sample.nParticles / wall;
+    summary_["status"] = "completed";
+    io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records));
+    io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
+    if (config_.output.plots) makePlots(dir_, quiet_);
+    if (!quiet_) {
+      if (summary_.contains("phi_peak_deg"))
+        std::printf("phi_peak = %.2f deg at eps1 = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, "
+                    "E = %.1f MPa, nu = %.3f\n",
+                    summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
+                    summary_["phi_res_deg"].get<double>(), summary_["psi_max_deg"].get<double>(),
+                    summary_["E_MPa"].get<double>(), summary_["nu"].get<double>());
+      std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, dir_.c_str());
+    }
+    return 0;
+  }
+
+  const lab::RunConfig& config_;
+  fs::path dir_;
+  bool quiet_;
+  ProgressLine progress_;
+  json summary_;
+  double secondsBefore_;
+  std::chrono::steady_clock::time_point t0_;
+  io::VtkSeries vtk_;
+  lab::Laboratory lab_;
+};
+
+int finish(RunSession& session, const lab::RunConfig& config) {
+  try {
+    return config.test.type == "triaxial" ? session.finishTriaxial() : session.finishIsotropic();
+  } catch (const SimulationError& e) {
+    session.writeFailure(e.what());
+    throw;
+  }
+}
+
+}  // namespace
+
 int runLab(const RunOptions& opt) {
   const lab::RunConfig config = resolveConfig(opt);
   omp_set_num_threads(config.solver.threads);
-
   const fs::path dir = config.output.dir;
   fs::create_directories(dir);
   io::writeFileAtomic(dir / "config.resolved.toml", io::toTomlString(io::resolvedTable(config)));
+  // A new run replaces whatever an earlier run left in the folder's checkpoint.
+  fs::remove_all(dir / "checkpoint");
 
-  ProgressLine progress(opt.quiet);
-  const auto t0 = std::chrono::steady_clock::now();
   json summary;
   summary["config_source"] = opt.config;
   summary["n_particles"] = config.sample.nParticles;
@@ -84,20 +242,9 @@ int runLab(const RunOptions& opt) {
   summary["test"] = config.test.type;
   summary["e0_target"] = config.sample.e0;
   summary["threads"] = config.solver.threads;
+  RunSession session(config, dir, opt.quiet, summary, 0.0);
+  lab::Laboratory& lab = session.lab();
   try {
-    lab::Laboratory lab(config, [&](const std::string& phase, double f, long steps) {
-      progress.update(phase, f, steps);
-    });
-    io::VtkSeries vtk(dir / "vtk");
-    if (config.output.vtkEveryStrain > 0.0)
-      lab.onSnapshot(
-          [&](const Simulation& s, double eps1) {
-            const lab::GrainKinematics k = lab.currentKinematics();
-            vtk.write(s, eps1,
-                      {{{"local_shear_strain", k.localShearStrain}, {"in_band", k.inBand}},
-                       {{"displacement", k.displacement}}});
-          },
-          config.output.vtkEveryStrain);
     lab::PreparationResult prep;
     if (config.sample.packing.empty()) {
       prep = lab.prepare();
@@ -106,117 +253,86 @@ int runLab(const RunOptions& opt) {
       io::loadPacking(config.sample.packing, config.sample.density, packed);
       prep = lab.adoptPacking(std::move(packed));
     }
+    session.progress().finish();
+    const Simulation& sim = lab.simulation();
     if (config.output.savePacking)
       io::writeFileAtomic(dir / "packing.txt",
-                          io::packingText(lab.simulation(), fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}",
-                                                                        prep.e0, config.test.confiningPressure, config.sample.seed)));
-    progress.finish();
-    const Simulation& sim = lab.simulation();
-    summary["e0"] = finite(prep.e0, "e0");
+                          io::packingText(sim, fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}",
+                                                           prep.e0, config.test.confiningPressure, config.sample.seed)));
+    json& s = session.summary();
+    s["e0"] = finite(prep.e0, "e0");
     // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
-    summary["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
-    summary["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
-    summary["prep_friction_deg"] = prep.prepFrictionDeg;
+    s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
+    s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
+    s["prep_friction_deg"] = prep.prepFrictionDeg;
     json search = json::array();
     for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
-    summary["prep_search"] = search;
-    summary["grading"] = gradingJson(prep.grading);
+    s["prep_search"] = search;
+    s["grading"] = gradingJson(prep.grading);
     if (config.contact.model == "rolling-linear") {
       const auto& mu = sim.particles.rollingFriction;
       double sum = 0.0;
       for (double m : mu) sum += m;
-      summary["mu_r_mean"] = sum / static_cast<double>(mu.size());
-      summary["mu_r_min"] = *std::min_element(mu.begin(), mu.end());
-      summary["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
+      s["mu_r_mean"] = sum / static_cast<double>(mu.size());
+      s["mu_r_min"] = *std::min_element(mu.begin(), mu.end());
+      s["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
     }
-    summary["isotropic_state"] = equilibriumJson(prep.state);
-    summary["dt"] = sim.dt;
-    summary["dt_critical"] = sim.criticalTimeStep();
-    summary["preparation_steps"] = prep.steps;
+    s["isotropic_state"] = equilibriumJson(prep.state);
+    s["dt"] = sim.dt;
+    s["dt_critical"] = sim.criticalTimeStep();
+    s["preparation_steps"] = prep.steps;
     if (!opt.quiet)
       std::fprintf(stderr, "prepared: e0 = %.4f (target %.3f, mu_prep = %.2f deg), p = %.1f kPa\n",
-                   prep.e0, config.sample.e0, prep.prepFrictionDeg,
-                   (prep.state.wallStress.sum() / 3.0) / 1e3);
-
-    std::vector<lab::Record> records;
-    long steps = prep.steps;
-    if (config.test.type == "triaxial") {
-      lab::ShearResult shear = lab.shear();
-      progress.finish();
-      records = std::move(shear.records);
-      steps += shear.steps;
-      lab::TriaxialCurves curves;
-      for (const auto& r : records) {
-        curves.eps1.push_back(r.eps1);
-        curves.epsV.push_back(r.epsV);
-        curves.sigma1.push_back(r.sigma1);
-        curves.sigma3.push_back(0.5 * (r.sigma2 + r.sigma3));
-        curves.voidRatio.push_back(r.e);
-      }
-      const lab::MacroParameters m = lab::computeMacro(curves);
-      summary["phi_peak_deg"] = finite(m.phiPeakDeg, "phi_peak_deg");
-      summary["eps1_at_peak"] = m.eps1AtPeak;
-      summary["q_peak"] = m.qPeak;
-      summary["phi_res_deg"] = finite(m.phiResDeg, "phi_res_deg");
-      summary["residual_window_eps1"] = {m.residualFrom, records.back().eps1};
-      summary["psi_max_deg"] = finite(m.psiMaxDeg, "psi_max_deg");
-      summary["eps1_at_psi_max"] = m.eps1AtPsiMax;
-      summary["E_MPa"] = finite(m.youngModulus / 1e6, "E_MPa");
-      summary["E50_MPa"] = finite(m.e50 / 1e6, "E50_MPa");
-      summary["nu"] = finite(m.poisson, "nu");
-      summary["cs_q_over_p"] = m.csStressRatio;
-      summary["cs_void_ratio"] = m.csVoidRatio;
-      summary["strain_rate"] = shear.strainRate;
-      summary["inertial_number"] = shear.inertialNumber;
-      summary["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
-      summary["final_axial_strain"] = records.back().eps1;
-      summary["shear_steps"] = shear.steps;
-      // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
-      const lab::GrainKinematics k = lab.currentKinematics();
-      summary["rotation_mean_deg"] = k.rotationMeanDeg;
-      summary["rotation_band_mean_deg"] = k.rotationBandMeanDeg;
-      summary["rotation_outside_band_mean_deg"] = k.rotationOutsideMeanDeg;
-      summary["band_fraction"] = k.bandFraction;
-      // I = rate d50 sqrt(rho/p) with the p measured at each record.
-      double inertialMax = 0.0;
-      for (const auto& r : records) inertialMax = std::max(inertialMax, r.inertialNumber);
-      summary["inertial_number_max"] = inertialMax;
-      summary["quasi_static"] = inertialMax <= 1e-3;
-      if (inertialMax > 1e-3)
-        std::fprintf(stderr, "grainlab: warning: inertial number reached %.2e > 1e-3: the test was not quasi-static\n",
-                     inertialMax);
-    } else {
-      if (config.output.vtkEveryStrain > 0.0) vtk.write(sim, 0.0);
-      records.push_back(lab.measure(sim.box.length(2), sim.box.volume(),
-                                    Vec3(sim.box.length(0), sim.box.length(1), sim.box.length(2)), 0.0));
-    }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    summary["steps"] = steps;
-    summary["wall_seconds"] = wall;
-    summary["particle_steps_per_s"] = static_cast<double>(steps) * config.sample.nParticles / wall;
-    summary["status"] = "completed";
-    io::writeFileAtomic(dir / "timeseries.csv", io::timeseriesCsv(records));
-    io::writeFileAtomic(dir / "summary.json", summary.dump(2) + "\n");
-    if (config.output.plots) makePlots(dir, opt.quiet);
-    if (!opt.quiet) {
-      if (summary.contains("phi_peak_deg"))
-        std::printf("phi_peak = %.2f deg at eps1 = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, "
-                    "E = %.1f MPa, nu = %.3f\n",
-                    summary["phi_peak_deg"].get<double>(), summary["eps1_at_peak"].get<double>(),
-                    summary["phi_res_deg"].get<double>(), summary["psi_max_deg"].get<double>(),
-                    summary["E_MPa"].get<double>(), summary["nu"].get<double>());
-      std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, dir.c_str());
-    }
-    return 0;
+                   prep.e0, config.sample.e0, prep.prepFrictionDeg, (prep.state.wallStress.sum() / 3.0) / 1e3);
   } catch (const SimulationError& e) {
-    progress.finish();
-    summary["status"] = "failed";
-    summary["error"] = e.what();
-    summary["wall_seconds"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    io::writeFileAtomic(dir / "summary.json", summary.dump(2) + "\n");
+    session.writeFailure(e.what());
     throw;
   }
+  return finish(session, config);
+}
+
+int resumeLab(const ResumeOptions& opt) {
+  const fs::path dir = opt.dir;
+  const fs::path stateFile = dir / "checkpoint" / "state.bin";
+  if (!fs::exists(dir / "config.resolved.toml"))
+    throw InputError(fmt::format("resume {}: no config.resolved.toml there (not a grainlab results folder)", dir.string()));
+  if (!fs::exists(stateFile))
+    throw InputError(fmt::format("resume {}: no checkpoint/state.bin (checkpoints are written during shearing, "
+                                 "every output.checkpoint_every of axial strain)", dir.string()));
+  RunOptions resolved;
+  resolved.config = (dir / "config.resolved.toml").string();
+  lab::RunConfig config = resolveConfig(resolved);
+  omp_set_num_threads(config.solver.threads);
+  if (fs::exists(dir / "summary.json")) {
+    std::ifstream in(dir / "summary.json");
+    json done;
+    in >> done;
+    if (done.value("status", "") == "completed") {
+      if (!opt.quiet) std::printf("%s: run already completed\n", dir.c_str());
+      return 0;
+    }
+  }
+  std::ifstream in(stateFile, std::ios::binary);
+  std::string headerLine;
+  std::getline(in, headerLine);
+  json header;
+  try {
+    header = json::parse(headerLine);
+  } catch (const json::exception&) {
+    throw InputError(fmt::format("resume {}: checkpoint/state.bin is not a grainlab checkpoint", dir.string()));
+  }
+  if (header.value("format", "") != "grainlab-checkpoint-1" || header.value("version", "") != GRAINLAB_VERSION)
+    throw InputError(fmt::format("resume {}: checkpoint written by another grainlab version ({})", dir.string(),
+                                 header.value("version", "?")));
+  RunSession session(config, dir, opt.quiet, header["summary"], header.value("wall_seconds", 0.0),
+                     header["vtk_labels"].get<std::vector<double>>());
+  try {
+    session.lab().loadState(in);
+  } catch (const std::exception& e) {
+    throw InputError(fmt::format("resume {}: cannot read the checkpoint: {}", dir.string(), e.what()));
+  }
+  if (!opt.quiet) std::fprintf(stderr, "resuming %s at step %ld\n", dir.c_str(), session.lab().simulation().stepCount);
+  return finish(session, config);
 }
 
 }  // namespace grainlab::cli

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/state_io.hpp"
+
 namespace grainlab {
 
 namespace {
@@ -27,6 +29,40 @@ void mergeHistory(const std::vector<std::uint64_t>& oldKeys,
 }
 
 }  // namespace
+
+void NeighborList::saveState(std::ostream& out) const {
+  using namespace stateio;
+  putVector(out, pairA);
+  putVector(out, pairB);
+  putVector(out, pairHistory);
+  putVector(out, incidentStart);
+  putVector(out, incident);
+  putVector(out, wallParticle);
+  putVector(out, wallIndex);
+  putVector(out, wallHistory);
+  putVector(out, wallStart);
+  put(out, skin);
+  put(out, builds);
+  putVector(out, positionAtBuild_);
+  put(out, wallPositionAtBuild_);
+}
+
+void NeighborList::loadState(std::istream& in) {
+  using namespace stateio;
+  getVector(in, pairA);
+  getVector(in, pairB);
+  getVector(in, pairHistory);
+  getVector(in, incidentStart);
+  getVector(in, incident);
+  getVector(in, wallParticle);
+  getVector(in, wallIndex);
+  getVector(in, wallHistory);
+  getVector(in, wallStart);
+  get(in, skin);
+  get(in, builds);
+  getVector(in, positionAtBuild_);
+  get(in, wallPositionAtBuild_);
+}
 
 bool NeighborList::wallsMoved(const WallBox& box) const {
   for (int k = 0; k < 6; ++k)

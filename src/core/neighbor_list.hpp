@@ -6,6 +6,7 @@
 // pairs are listed in a fixed order (CSR) so force sums do not depend on the thread count.
 #include <array>
 #include <cstdint>
+#include <iosfwd>
 #include <vector>
 
 #include "contact/models.hpp"
@@ -38,6 +39,10 @@ class NeighborList {
   bool wallsMoved(const WallBox& box) const;
 
   const std::vector<Vec3>& positionsAtBuild() const { return positionAtBuild_; }
+
+  // Exact binary state for checkpoints (state_io.hpp).
+  void saveState(std::ostream& out) const;
+  void loadState(std::istream& in);
 
  private:
   std::vector<Vec3> positionAtBuild_;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/state_io.hpp"
+
 namespace grainlab {
 
 void Particles::addSphere(const Vec3& x, double r, double density) {
@@ -34,6 +36,42 @@ double Particles::rotationAngle(std::size_t i) const {
   // |w| of a unit quaternion is cos(theta/2) up to sign; take the shorter rotation.
   const double w = std::min(1.0, std::abs(rel.w()));
   return 2.0 * std::acos(w);
+}
+
+void Particles::saveState(std::ostream& out) const {
+  using namespace stateio;
+  putVector(out, position);
+  putVector(out, velocity);
+  putVector(out, orientation);
+  putVector(out, angularVelocity);
+  putVector(out, force);
+  putVector(out, torque);
+  putVector(out, radius);
+  putVector(out, mass);
+  putVector(out, inertia);
+  putVector(out, rollingFriction);
+  putVector(out, sphericity);
+  putVector(out, referencePosition);
+  putVector(out, referenceOrientation);
+  putVector(out, rotationPath);
+}
+
+void Particles::loadState(std::istream& in) {
+  using namespace stateio;
+  getVector(in, position);
+  getVector(in, velocity);
+  getVector(in, orientation);
+  getVector(in, angularVelocity);
+  getVector(in, force);
+  getVector(in, torque);
+  getVector(in, radius);
+  getVector(in, mass);
+  getVector(in, inertia);
+  getVector(in, rollingFriction);
+  getVector(in, sphericity);
+  getVector(in, referencePosition);
+  getVector(in, referenceOrientation);
+  getVector(in, rotationPath);
 }
 
 double Particles::solidVolume() const {

@@ -1,5 +1,6 @@
 #pragma once
 // Particle storage as structure-of-arrays: the hot loops touch only the arrays they need.
+#include <iosfwd>
 #include <vector>
 
 #include "core/types.hpp"
@@ -36,6 +37,9 @@ struct Particles {
   // Angle [rad] of the composed rotation of particle i since its reference orientation.
   double rotationAngle(std::size_t i) const;
   double solidVolume() const;
+  // Exact binary state for checkpoints (state_io.hpp).
+  void saveState(std::ostream& out) const;
+  void loadState(std::istream& in);
 };
 
 }  // namespace grainlab

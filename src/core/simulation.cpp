@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
+#include "core/state_io.hpp"
 #include "geometry/sphere_contacts.hpp"
 
 namespace grainlab {
@@ -267,6 +268,48 @@ void Simulation::integrate() {
   }
   const double halfSkin = neighbors.halfSkin();
   if (maxDisp2 > halfSkin * halfSkin) rebuildDue_ = true;
+}
+
+void Simulation::saveState(std::ostream& out) const {
+  using namespace stateio;
+  particles.saveState(out);
+  put(out, box);
+  neighbors.saveState(out);
+  put(out, model);
+  put(out, servo);
+  put(out, energy);
+  put(out, gravity);
+  put(out, dt);
+  put(out, localDamping);
+  put(out, stepCount);
+  put(out, time);
+  putVector(out, pairForce);
+  putVector(out, pairTorqueA);
+  putVector(out, pairTorqueB);
+  putVector(out, wallForce);
+  putVector(out, wallTorque);
+  put(out, rebuildDue_);
+}
+
+void Simulation::loadState(std::istream& in) {
+  using namespace stateio;
+  particles.loadState(in);
+  get(in, box);
+  neighbors.loadState(in);
+  get(in, model);
+  get(in, servo);
+  get(in, energy);
+  get(in, gravity);
+  get(in, dt);
+  get(in, localDamping);
+  get(in, stepCount);
+  get(in, time);
+  getVector(in, pairForce);
+  getVector(in, pairTorqueA);
+  getVector(in, pairTorqueB);
+  getVector(in, wallForce);
+  getVector(in, wallTorque);
+  get(in, rebuildDue_);
 }
 
 std::size_t Simulation::touchingPairs() const {

@@ -69,6 +69,10 @@ class Simulation {
   // Number of touching particle-particle contacts at the latest step.
   std::size_t touchingPairs() const;
 
+  // Exact binary state for checkpoints: a loaded simulation continues bit for bit.
+  void saveState(std::ostream& out) const;
+  void loadState(std::istream& in);
+
  private:
   void computeContacts();
   void gatherForces();

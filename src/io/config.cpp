@@ -356,6 +356,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 0.0, 0.1, true, false, "must be in (0, 0.1]");
   c.output.plots = o.boolean("plots", c.output.plots);
   c.output.savePacking = o.boolean("save_packing", c.output.savePacking);
+  c.output.checkpointEvery = o.number("checkpoint_every", c.output.checkpointEvery, 0.0, 1.0, false, false,
+                                      "must be in [0, 1] (axial strain between checkpoints; 0: none)");
   c.output.vtkEveryStrain = o.number("vtk_every_strain", c.output.vtkEveryStrain, 0.0, 1.0, false, false,
                                      "must be in [0, 1] (0: no VTK snapshots)");
   o.finish();
@@ -426,7 +428,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                      {"record_every_strain", c.output.recordEveryStrain},
                      {"plots", c.output.plots},
                      {"save_packing", c.output.savePacking},
-                     {"vtk_every_strain", c.output.vtkEveryStrain}};
+                     {"vtk_every_strain", c.output.vtkEveryStrain},
+                     {"checkpoint_every", c.output.checkpointEvery}};
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
                      {"solver", solver}, {"output", output}};
 }

@@ -17,11 +17,13 @@ struct PointFields {
 
 class VtkSeries {
  public:
-  explicit VtkSeries(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  // `labels`: the snapshots an interrupted run already wrote (resume continues the numbering).
+  explicit VtkSeries(std::filesystem::path dir, std::vector<double> labels = {})
+      : dir_(std::move(dir)), labels_(std::move(labels)) {}
   // Writes particles_NNNN.vtu, contacts_NNNN.vtu, walls_NNNN.vtu and updates the three .pvd files;
   // `label` is the collection's time value (the axial strain during shearing).
   void write(const Simulation& sim, double label, const PointFields& extra = {});
-  std::size_t snapshots() const { return labels_.size(); }
+  const std::vector<double>& labels() const { return labels_; }
 
  private:
   std::filesystem::path dir_;

@@ -9,6 +9,7 @@
 #include "lab/macro.hpp"
 #include "lab/measurements.hpp"
 #include "lab/placement.hpp"
+#include "core/state_io.hpp"
 #include "lab/sphericity.hpp"
 
 namespace grainlab::lab {
@@ -281,18 +282,20 @@ Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRa
   return r;
 }
 
-ShearResult Laboratory::shear() {
-  ShearResult out;
+void Laboratory::beginShear() {
+  ShearState& st = shear_;
+  st = ShearState{};
   const double p = config_.test.confiningPressure;
   const double rho = config_.sample.density;
   setFriction(config_.contact.frictionDeg);
   // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3.
-  out.strainRate = config_.test.axialStrainRate.value_or(1e-3 / (d50_ * std::sqrt(rho / p)));
-  out.inertialNumber = out.strainRate * d50_ * std::sqrt(rho / p);
+  st.result.strainRate = config_.test.axialStrainRate.value_or(1e-3 / (d50_ * std::sqrt(rho / p)));
+  st.result.inertialNumber = st.result.strainRate * d50_ * std::sqrt(rho / p);
 
   WallBox& box = sim_.box;
-  const double h0 = box.length(2), v0 = box.volume();
-  const Vec3 l0(box.length(0), box.length(1), box.length(2));
+  st.h0 = box.length(2);
+  st.v0 = box.volume();
+  st.l0 = Vec3(box.length(0), box.length(1), box.length(2));
   for (int a = 0; a < 2; ++a)
     for (int side = 0; side < 2; ++side) {
       Wall& w = box.walls[WallBox::index(a, side)];
@@ -302,50 +305,120 @@ ShearResult Laboratory::shear() {
   // Platens at constant speed: engineering axial strain rate on the initial height. The speed is
   // ramped up linearly over a few servo integral times, so that the lateral servos can learn how
   // fast their walls must move instead of lagging behind a sudden start.
-  const double platenSpeed = 0.5 * out.strainRate * h0;
-  const long rampSteps = std::max(1L, static_cast<long>(4.0 * config_.solver.servoIntegralSteps));
+  st.platenSpeed = 0.5 * st.result.strainRate * st.h0;
+  st.rampSteps = std::max(1L, static_cast<long>(4.0 * config_.solver.servoIntegralSteps));
   box.lower(2).control = WallControl::Velocity;
   box.upper(2).control = WallControl::Velocity;
   sim_.particles.resetKinematicReference();
-  shearReference_ = l0;
+  shearReference_ = st.l0;
   sim_.energy = EnergyLedger{};
 
+  st.result.records.push_back(measure(st.h0, st.v0, st.l0, st.result.strainRate));
+  // Records are ten times denser below 1 % axial strain, where E and nu are measured.
+  const double every = config_.output.recordEveryStrain;
+  st.nextRecord = std::min(every, 0.1 * every);
+  st.nextSnapshot = snapshotEvery_;
+  st.nextCheckpoint = checkpointEvery_;
+  st.startStep = sim_.stepCount;
+  st.started = true;
+  if (snapshot_) snapshot_(sim_, 0.0);
+}
+
+ShearResult Laboratory::continueShear() {
+  ShearState& st = shear_;
+  const double p = config_.test.confiningPressure;
   const double finalStrain = config_.test.finalAxialStrain;
   const double every = config_.output.recordEveryStrain;
-  out.records.push_back(measure(h0, v0, l0, out.strainRate));
-  // Records are ten times denser below 1 % axial strain, where E and nu are measured.
-  double nextRecord = std::min(every, 0.1 * every);
-  double nextSnapshot = snapshotEvery_;
-  if (snapshot_) snapshot_(sim_, 0.0);
-  const long startStep = sim_.stepCount;
+  WallBox& box = sim_.box;
   while (true) {
-    const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - startStep + 1) / rampSteps);
-    box.lower(2).velocity = ramp * platenSpeed;
-    box.upper(2).velocity = -ramp * platenSpeed;
+    const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps);
+    box.lower(2).velocity = ramp * st.platenSpeed;
+    box.upper(2).velocity = -ramp * st.platenSpeed;
     sim_.step();
-    const double eps1 = (h0 - box.length(2)) / h0;
+    const double eps1 = (st.h0 - box.length(2)) / st.h0;
     const bool last = eps1 >= finalStrain;
-    if (eps1 >= nextRecord || last) {
-      Record r = measure(h0, v0, l0, out.strainRate);
-      out.maxLateralDeviation = std::max(
-          {out.maxLateralDeviation, std::abs(r.sigma2 - p) / p, std::abs(r.sigma3 - p) / p});
-      out.records.push_back(r);
-      while (nextRecord <= eps1) nextRecord += eps1 < 0.01 ? 0.1 * every : every;
+    if (eps1 >= st.nextRecord || last) {
+      Record r = measure(st.h0, st.v0, st.l0, st.result.strainRate);
+      st.result.maxLateralDeviation = std::max(
+          {st.result.maxLateralDeviation, std::abs(r.sigma2 - p) / p, std::abs(r.sigma3 - p) / p});
+      st.result.records.push_back(r);
+      while (st.nextRecord <= eps1) st.nextRecord += eps1 < 0.01 ? 0.1 * every : every;
     }
-    if (snapshot_ && snapshotEvery_ > 0.0 && (eps1 >= nextSnapshot || last)) {
+    if (snapshot_ && snapshotEvery_ > 0.0 && (eps1 >= st.nextSnapshot || last)) {
       snapshot_(sim_, eps1);
-      while (nextSnapshot <= eps1) nextSnapshot += snapshotEvery_;
+      while (st.nextSnapshot <= eps1) st.nextSnapshot += snapshotEvery_;
     }
-    if (progress_ && (sim_.stepCount - startStep) % 2000 == 0)
-      progress_("triaxial shearing", std::min(1.0, eps1 / finalStrain), sim_.stepCount - startStep);
+    if (progress_ && (sim_.stepCount - st.startStep) % 2000 == 0)
+      progress_("triaxial shearing", std::min(1.0, eps1 / finalStrain), sim_.stepCount - st.startStep);
     if (last) break;
-    if (sim_.stepCount - startStep >= config_.solver.maxSteps)
+    // Checkpoints between steps, after the step's records and snapshots: a resumed run repeats none.
+    if (checkpoint_ && checkpointEvery_ > 0.0 && eps1 >= st.nextCheckpoint) {
+      while (st.nextCheckpoint <= eps1) st.nextCheckpoint += checkpointEvery_;
+      checkpoint_(*this);
+    }
+    if (sim_.stepCount - st.startStep >= config_.solver.maxSteps)
       throw SimulationError(fmt::format("triaxial shearing: reached solver.max_steps = {} at eps1 = {:.4f}",
                                         config_.solver.maxSteps, eps1));
   }
-  if (progress_) progress_("triaxial shearing", 1.0, sim_.stepCount - startStep);
-  out.steps = sim_.stepCount - startStep;
-  return out;
+  if (progress_) progress_("triaxial shearing", 1.0, sim_.stepCount - st.startStep);
+  st.result.steps = sim_.stepCount - st.startStep;
+  return st.result;
+}
+
+ShearResult Laboratory::shear() {
+  beginShear();
+  return continueShear();
+}
+
+void Laboratory::saveState(std::ostream& out) const {
+  using namespace stateio;
+  sim_.saveState(out);
+  put(out, d50_);
+  const bool hasReference = shearReference_.has_value();
+  put(out, hasReference);
+  put(out, hasReference ? *shearReference_ : Vec3::Zero().eval());
+  const ShearState& st = shear_;
+  put(out, st.started);
+  put(out, st.h0);
+  put(out, st.v0);
+  put(out, st.l0);
+  put(out, st.platenSpeed);
+  put(out, st.rampSteps);
+  put(out, st.startStep);
+  put(out, st.nextRecord);
+  put(out, st.nextSnapshot);
+  put(out, st.nextCheckpoint);
+  put(out, st.result.strainRate);
+  put(out, st.result.inertialNumber);
+  put(out, st.result.maxLateralDeviation);
+  putVector(out, st.result.records);
+}
+
+void Laboratory::loadState(std::istream& in) {
+  using namespace stateio;
+  sim_.loadState(in);
+  get(in, d50_);
+  bool hasReference = false;
+  Vec3 reference;
+  get(in, hasReference);
+  get(in, reference);
+  shearReference_.reset();
+  if (hasReference) shearReference_ = reference;
+  ShearState& st = shear_;
+  get(in, st.started);
+  get(in, st.h0);
+  get(in, st.v0);
+  get(in, st.l0);
+  get(in, st.platenSpeed);
+  get(in, st.rampSteps);
+  get(in, st.startStep);
+  get(in, st.nextRecord);
+  get(in, st.nextSnapshot);
+  get(in, st.nextCheckpoint);
+  get(in, st.result.strainRate);
+  get(in, st.result.inertialNumber);
+  get(in, st.result.maxLateralDeviation);
+  getVector(in, st.result.records);
 }
 
 }  // namespace grainlab::lab

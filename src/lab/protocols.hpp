@@ -3,6 +3,7 @@
 // preparation friction (searched to meet a target e0), isotropic compression to the confining
 // pressure, and drained triaxial compression.
 #include <functional>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@ namespace grainlab::lab {
 using ProgressFn = std::function<void(const std::string& phase, double fraction, long steps)>;
 // Called for snapshots (e.g. VTK) during shearing, with the current axial strain.
 using SnapshotFn = std::function<void(const Simulation& sim, double eps1)>;
+class Laboratory;
+// Called to write a checkpoint (between steps, during shearing).
+using CheckpointFn = std::function<void(const Laboratory& lab)>;
 
 // One row of the time series (PHYSICS.md §0 signs: compression positive, eps_v > 0 contraction).
 struct Record {
@@ -68,8 +72,21 @@ class Laboratory {
   // stiffness and friction at the confining pressure, no compaction and no e0 search.
   PreparationResult adoptPacking(Simulation packed);
   // Drained triaxial compression of the prepared sample (platens at constant speed, lateral walls
-  // servo-controlled at sigma3 = p) to the final axial strain.
+  // servo-controlled at sigma3 = p) to the final axial strain: beginShear() then continueShear().
   ShearResult shear();
+  void beginShear();
+  // Runs (or, after loadState, resumes) the shearing loop to the final axial strain.
+  ShearResult continueShear();
+  bool shearStarted() const { return shear_.started; }
+
+  // Checkpoints every `everyStrain` of axial strain during shearing.
+  void onCheckpoint(CheckpointFn fn, double everyStrain) {
+    checkpoint_ = std::move(fn);
+    checkpointEvery_ = everyStrain;
+  }
+  // Exact binary state (engine and shearing protocol) for checkpoints.
+  void saveState(std::ostream& out) const;
+  void loadState(std::istream& in);
 
   // Snapshots every `everyStrain` of axial strain during shearing (and at its start and end).
   void onSnapshot(SnapshotFn fn, double everyStrain) {
@@ -93,6 +110,19 @@ class Laboratory {
   ProgressFn progress_;
   SnapshotFn snapshot_;
   double snapshotEvery_ = 0.0;
+  CheckpointFn checkpoint_;
+  double checkpointEvery_ = 0.0;
+  // Where the shearing loop stands (all of it goes into a checkpoint).
+  struct ShearState {
+    bool started = false;
+    double h0 = 0.0, v0 = 0.0;
+    Vec3 l0 = Vec3::Zero();
+    double platenSpeed = 0.0;
+    long rampSteps = 1, startStep = 0;
+    double nextRecord = 0.0, nextSnapshot = 0.0, nextCheckpoint = 0.0;
+    ShearResult result;
+  };
+  ShearState shear_;
   Simulation sim_;
   double d50_ = 0.0;
   std::optional<Vec3> shearReference_;  // box lengths at the start of shearing

@@ -82,6 +82,7 @@ struct OutputConfig {
   bool plots = true;
   bool savePacking = true;  // packing.txt of the prepared sample, reusable as sample.packing
   double vtkEveryStrain = 0.01;  // ParaView snapshots during shearing; 0 = none
+  double checkpointEvery = 0.01;  // checkpoints during shearing, in axial strain; 0 = none
 };
 
 struct RunConfig {
