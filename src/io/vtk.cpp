@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "io/results.hpp"
+#include "lab/measurements.hpp"
 
 namespace grainlab::io {
 
@@ -82,15 +83,8 @@ std::string pvd(const std::string& kind, const std::vector<double>& labels) {
 std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   const Particles& P = sim.particles;
   const std::size_t n = P.size();
-  std::vector<double> contacts(n, 0.0), angle(n), path(n);
-  const auto& nl = sim.neighbors;
-  for (std::size_t p = 0; p < nl.pairA.size(); ++p)
-    if (nl.pairHistory[p].touching) {
-      contacts[nl.pairA[p]] += 1.0;
-      contacts[nl.pairB[p]] += 1.0;
-    }
-  for (std::size_t c = 0; c < nl.wallParticle.size(); ++c)
-    if (nl.wallHistory[c].touching) contacts[nl.wallParticle[c]] += 1.0;
+  const std::vector<int> counts = lab::contactsPerParticle(sim);
+  std::vector<double> contacts(counts.begin(), counts.end()), angle(n), path(n);
   for (std::size_t i = 0; i < n; ++i) {
     angle[i] = radToDeg(P.rotationAngle(i));
     path[i] = radToDeg(P.rotationPath[i]);

@@ -13,7 +13,7 @@ double equivalentShearStrain(const Mat3& strain) {
 }
 
 GrainKinematics grainKinematics(const Particles& P, const std::vector<Vec3>& ref, const Mat3& boxStrain,
-                                double radius, double bandFactor) {
+                                double radius, double bandFactor, const std::vector<char>& active) {
   const std::size_t n = P.size();
   GrainKinematics k;
   k.displacement.resize(n);
@@ -71,18 +71,20 @@ GrainKinematics grainKinematics(const Particles& P, const std::vector<Vec3>& ref
   }
 
   double sumAll = 0.0, sumBand = 0.0, sumOut = 0.0;
-  std::size_t band = 0;
+  std::size_t band = 0, counted = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const bool in = k.boxShearStrain > 0.0 && k.localShearStrain[i] >= bandFactor * k.boxShearStrain;
     k.inBand[i] = in ? 1.0 : 0.0;
+    if (!active.empty() && !active[i]) continue;
+    ++counted;
     sumAll += k.rotationDeg[i];
     (in ? sumBand : sumOut) += k.rotationDeg[i];
     band += in;
   }
-  k.rotationMeanDeg = n ? sumAll / n : 0.0;
+  k.rotationMeanDeg = counted ? sumAll / counted : 0.0;
   k.rotationBandMeanDeg = band ? sumBand / band : 0.0;
-  k.rotationOutsideMeanDeg = n > band ? sumOut / (n - band) : 0.0;
-  k.bandFraction = n ? static_cast<double>(band) / n : 0.0;
+  k.rotationOutsideMeanDeg = counted > band ? sumOut / (counted - band) : 0.0;
+  k.bandFraction = counted ? static_cast<double>(band) / counted : 0.0;
   return k;
 }
 

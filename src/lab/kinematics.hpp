@@ -8,6 +8,9 @@
 // any rigid motion), and the equivalent shear strain eq = sqrt(2/3 e:e) of its deviator e.
 // A grain is in the shear band when its eq is at least `bandFactor` times the eq of the box's own
 // (homogeneous) strain: localisation means grains deforming well above the average.
+// Rotation statistics and the band fraction count only grains that take part in the load-bearing
+// network (`active`, e.g. at least two contacts): a rattler touches nothing, feels no damping and
+// keeps whatever spin it had, which says nothing about the band.
 #include <vector>
 
 #include "core/particles.hpp"
@@ -23,7 +26,7 @@ struct GrainKinematics {
   double rotationMeanDeg = 0.0;
   double rotationBandMeanDeg = 0.0;     // 0 when no grain is in the band
   double rotationOutsideMeanDeg = 0.0;
-  double bandFraction = 0.0;
+  double bandFraction = 0.0;            // of the active grains
 };
 
 // Equivalent shear strain sqrt(2/3 e:e) of the deviator of a strain tensor.
@@ -31,7 +34,9 @@ double equivalentShearStrain(const Mat3& strain);
 
 // `boxStrain`: the box's homogeneous Green–Lagrange strain (diagonal for a wall box);
 // `radius`: neighbourhood radius [m]; `bandFactor`: threshold on eq / eq_box.
+// `active`: grains counted in the statistics (empty: all).
 GrainKinematics grainKinematics(const Particles& particles, const std::vector<Vec3>& referencePosition,
-                                const Mat3& boxStrain, double radius, double bandFactor = 2.0);
+                                const Mat3& boxStrain, double radius, double bandFactor = 2.0,
+                                const std::vector<char>& active = {});
 
 }  // namespace grainlab::lab

@@ -56,6 +56,19 @@ double voidRatio(const Simulation& sim) {
   return sim.box.volume() / sim.particles.solidVolume() - 1.0;
 }
 
+std::vector<int> contactsPerParticle(const Simulation& sim) {
+  std::vector<int> contacts(sim.particles.size(), 0);
+  const auto& nl = sim.neighbors;
+  for (std::size_t p = 0; p < nl.pairA.size(); ++p)
+    if (nl.pairHistory[p].touching) {
+      ++contacts[nl.pairA[p]];
+      ++contacts[nl.pairB[p]];
+    }
+  for (std::size_t c = 0; c < nl.wallParticle.size(); ++c)
+    if (nl.wallHistory[c].touching) ++contacts[nl.wallParticle[c]];
+  return contacts;
+}
+
 double coordinationNumber(const Simulation& sim) {
   return 2.0 * static_cast<double>(sim.touchingPairs()) / static_cast<double>(sim.particles.size());
 }

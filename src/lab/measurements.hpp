@@ -17,6 +17,8 @@ Mat3 contactStress(const Simulation& sim);
 Vec3 wallStress(const Simulation& sim);
 
 double voidRatio(const Simulation& sim);
+// Touching contacts of every particle, wall contacts included.
+std::vector<int> contactsPerParticle(const Simulation& sim);
 // Z = 2 Nc / Np over touching particle-particle contacts.
 double coordinationNumber(const Simulation& sim);
 double kineticEnergy(const Simulation& sim);

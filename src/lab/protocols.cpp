@@ -240,8 +240,12 @@ GrainKinematics Laboratory::currentKinematics() const {
     const double stretch = sim_.box.length(a) / l0[a];
     boxStrain(a, a) = 0.5 * (stretch * stretch - 1.0);
   }
+  // Grains with at least two contacts (walls included) carry load; the others are rattlers.
+  const std::vector<int> contacts = contactsPerParticle(sim_);
+  std::vector<char> active(contacts.size());
+  for (std::size_t i = 0; i < contacts.size(); ++i) active[i] = contacts[i] >= 2;
   return grainKinematics(sim_.particles, sim_.particles.referencePosition, boxStrain,
-                         kNeighbourhoodDiameters * d50_);
+                         kNeighbourhoodDiameters * d50_, 2.0, active);
 }
 
 Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate) const {
