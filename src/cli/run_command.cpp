@@ -105,7 +105,7 @@ class RunSession {
   // checkpoint/state.bin: a JSON header line (summary so far, VTK snapshot times, wall time) and the
   // exact binary state, written as one file and renamed into place.
   void writeCheckpoint() {
-    json header{{"format", "grainlab-checkpoint-1"}, {"version", GRAINLAB_VERSION}, {"summary", summary_},
+    json header{{"format", "grainlab-checkpoint-2"}, {"version", GRAINLAB_VERSION}, {"summary", summary_},
                 {"vtk_labels", vtk_.labels()}, {"wall_seconds", seconds()}};
     std::ostringstream out(std::ios::binary);
     out << header.dump() << '\n';
@@ -146,6 +146,9 @@ class RunSession {
     summary_["strain_rate"] = shear.strainRate;
     summary_["inertial_number"] = shear.inertialNumber;
     summary_["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
+    if (shear.maxLateralDeviation > 0.02)
+      std::fprintf(stderr, "grainlab: warning: lateral stress deviated from sigma3 by up to %.1f %% (> 2 %%)\n",
+                   100.0 * shear.maxLateralDeviation);
     summary_["final_axial_strain"] = records.back().eps1;
     summary_["shear_steps"] = shear.steps;
     // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
@@ -321,7 +324,7 @@ int resumeLab(const ResumeOptions& opt) {
   } catch (const json::exception&) {
     throw InputError(fmt::format("resume {}: checkpoint/state.bin is not a grainlab checkpoint", dir.string()));
   }
-  if (header.value("format", "") != "grainlab-checkpoint-1" || header.value("version", "") != GRAINLAB_VERSION)
+  if (header.value("format", "") != "grainlab-checkpoint-2" || header.value("version", "") != GRAINLAB_VERSION)
     throw InputError(fmt::format("resume {}: checkpoint written by another grainlab version ({})", dir.string(),
                                  header.value("version", "?")));
   RunSession session(config, dir, opt.quiet, header["summary"], header.value("wall_seconds", 0.0),

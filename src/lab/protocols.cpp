@@ -248,7 +248,8 @@ GrainKinematics Laboratory::currentKinematics() const {
                          kNeighbourhoodDiameters * d50_, 2.0, active);
 }
 
-Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate) const {
+Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate,
+                           const Vec3* meanStress) const {
   Record r;
   r.step = sim_.stepCount;
   r.time = sim_.time;
@@ -257,7 +258,7 @@ Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRa
   r.eps2 = (l0[0] - b.length(0)) / l0[0];
   r.eps3 = (l0[1] - b.length(1)) / l0[1];
   r.epsV = (v0 - b.volume()) / v0;
-  const Vec3 s = wallStress(sim_);
+  const Vec3 s = meanStress ? *meanStress : wallStress(sim_);
   r.sigma1 = s[2];
   r.sigma2 = s[0];
   r.sigma3 = s[1];
@@ -292,8 +293,10 @@ void Laboratory::beginShear() {
   const double p = config_.test.confiningPressure;
   const double rho = config_.sample.density;
   setFriction(config_.contact.frictionDeg);
-  // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3.
-  st.result.strainRate = config_.test.axialStrainRate.value_or(1e-3 / (d50_ * std::sqrt(rho / p)));
+  // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3, aimed at
+  // kAutoInertialNumber (2 % below the limit) so that the servo's small dips of p stay under it.
+  st.result.strainRate =
+      config_.test.axialStrainRate.value_or(kAutoInertialNumber / (d50_ * std::sqrt(rho / p)));
   st.result.inertialNumber = st.result.strainRate * d50_ * std::sqrt(rho / p);
 
   WallBox& box = sim_.box;
@@ -307,10 +310,11 @@ void Laboratory::beginShear() {
       w.targetStress = p;
     }
   // Platens at constant speed: engineering axial strain rate on the initial height. The speed is
-  // ramped up linearly over a few servo integral times, so that the lateral servos can learn how
-  // fast their walls must move instead of lagging behind a sudden start.
+  // ramped up linearly over kPlatenRampIntegralTimes servo integral times, so that the lateral
+  // servos learn how fast their walls must move instead of lagging behind a sudden start (with the
+  // stiff contacts of [W] sigma1 rises by several times p within 0.05 % of axial strain).
   st.platenSpeed = 0.5 * st.result.strainRate * st.h0;
-  st.rampSteps = std::max(1L, static_cast<long>(4.0 * config_.solver.servoIntegralSteps));
+  st.rampSteps = std::max(1L, static_cast<long>(kPlatenRampIntegralTimes * config_.solver.servoIntegralSteps));
   box.lower(2).control = WallControl::Velocity;
   box.upper(2).control = WallControl::Velocity;
   sim_.particles.resetKinematicReference();
@@ -339,10 +343,15 @@ ShearResult Laboratory::continueShear() {
     box.lower(2).velocity = ramp * st.platenSpeed;
     box.upper(2).velocity = -ramp * st.platenSpeed;
     sim_.step();
+    st.stressSum += wallStress(sim_);
+    ++st.stressSamples;
     const double eps1 = (st.h0 - box.length(2)) / st.h0;
     const bool last = eps1 >= finalStrain;
     if (eps1 >= st.nextRecord || last) {
-      Record r = measure(st.h0, st.v0, st.l0, st.result.strainRate);
+      const Vec3 meanStress = st.stressSum / static_cast<double>(st.stressSamples);
+      st.stressSum.setZero();
+      st.stressSamples = 0;
+      Record r = measure(st.h0, st.v0, st.l0, st.result.strainRate, &meanStress);
       st.result.maxLateralDeviation = std::max(
           {st.result.maxLateralDeviation, std::abs(r.sigma2 - p) / p, std::abs(r.sigma3 - p) / p});
       st.result.records.push_back(r);
@@ -392,6 +401,8 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.nextRecord);
   put(out, st.nextSnapshot);
   put(out, st.nextCheckpoint);
+  put(out, st.stressSum);
+  put(out, st.stressSamples);
   put(out, st.result.strainRate);
   put(out, st.result.inertialNumber);
   put(out, st.result.maxLateralDeviation);
@@ -419,6 +430,8 @@ void Laboratory::loadState(std::istream& in) {
   get(in, st.nextRecord);
   get(in, st.nextSnapshot);
   get(in, st.nextCheckpoint);
+  get(in, st.stressSum);
+  get(in, st.stressSamples);
   get(in, st.result.strainRate);
   get(in, st.result.inertialNumber);
   get(in, st.result.maxLateralDeviation);

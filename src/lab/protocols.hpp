@@ -103,7 +103,12 @@ class Laboratory {
   // neighbourhood of the local strain is kNeighbourhoodDiameters * d50.
   GrainKinematics currentKinematics() const;
   static constexpr double kNeighbourhoodDiameters = 2.0;
-  Record measure(double h0, double v0, const Vec3& l0, double strainRate) const;
+  static constexpr double kPlatenRampIntegralTimes = 40.0;
+  static constexpr double kAutoInertialNumber = 0.98e-3;
+  // A record of the current state; the wall stresses are meanStress when given (the mean over the
+  // recording interval, as a load cell reports it), else the instantaneous ones.
+  Record measure(double h0, double v0, const Vec3& l0, double strainRate,
+                 const Vec3* meanStress = nullptr) const;
 
  private:
   RunConfig config_;
@@ -120,6 +125,9 @@ class Laboratory {
     double platenSpeed = 0.0;
     long rampSteps = 1, startStep = 0;
     double nextRecord = 0.0, nextSnapshot = 0.0, nextCheckpoint = 0.0;
+    // Wall stresses summed over the steps since the last record: a record carries their mean.
+    Vec3 stressSum = Vec3::Zero();
+    long stressSamples = 0;
     ShearResult result;
   };
   ShearState shear_;

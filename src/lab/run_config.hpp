@@ -69,8 +69,8 @@ struct SolverConfig {
   int threads = 2;
   double unbalancedTolerance = 0.01;  // quasi-static threshold for the unbalanced-force ratio
   double stressTolerance = 0.01;      // relative, for isotropic equilibrium
-  double servoGain = 0.2;
-  double servoIntegralSteps = 500.0;
+  double servoGain = 0.5;
+  double servoIntegralSteps = 100.0;
   double servoMaxSpeed = 0.5;  // [m/s]
   double skinFraction = 0.2;   // Verlet skin as a fraction of the smallest radius
   long maxSteps = 50'000'000;  // safety limit per phase

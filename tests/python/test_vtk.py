@@ -46,7 +46,10 @@ def test_vtk_snapshots_read_back(grainlab, data_dir, tmp_path):
     walls = meshio.read(vtk / "walls_0002.vtu")
     assert len(walls.cells_dict["quad"]) == 6
     stress = walls.cell_data["normal_stress"][0].ravel()
-    # Walls in order x-, x+, y-, y+, z-, z+; the platens' mean is sigma1 of the last record.
-    assert abs(0.5 * (stress[4] + stress[5]) - float(last["sigma1"])) < 1e-6 * float(last["sigma1"])
-    assert abs(0.5 * (stress[0] + stress[1]) - float(last["sigma2"])) < 1e-6 * float(last["sigma2"])
+    # Walls in order x-, x+, y-, y+, z-, z+. The snapshot holds the walls' stresses at its step, the
+    # time series their mean over the last recording interval: the platens agree with sigma1 of the
+    # last record to the step-to-step noise, the lateral walls with the servo target.
+    assert abs(0.5 * (stress[4] + stress[5]) / float(last["sigma1"]) - 1.0) < 0.15
+    assert abs(0.5 * (stress[0] + stress[1]) / float(last["sigma2"]) - 1.0) < 0.05
+    assert stress[4] > 1.5 * stress[0]
     assert summary["status"] == "completed"
