@@ -164,7 +164,8 @@ int runSweep(const SweepOptions& opt) {
   // The comparison table: one row per case, its overrides and its macro-parameters.
   static const std::vector<std::string> columns{
       "e0", "phi_peak_deg", "eps1_at_peak", "phi_res_deg", "psi_max_deg", "E_MPa", "E50_MPa", "nu",
-      "cs_q_over_p", "cs_void_ratio", "inertial_number", "steps", "wall_seconds"};
+      "cs_q_over_p", "cs_void_ratio", "inertial_number", "inertial_number_max", "lateral_stress_max_deviation",
+      "steps", "wall_seconds"};
   std::string csv = "case,status";
   for (const auto& v : varies) csv += "," + csvField(v.key);
   for (const auto& c : columns) csv += "," + c;
