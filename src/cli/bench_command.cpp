@@ -1,6 +1,7 @@
 // `grainlab bench`: named scenes timed in particle-steps per second.
 #include <fmt/format.h>
 #include <omp.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include "io/results.hpp"
 #include "lab/measurements.hpp"
 #include "lab/protocols.hpp"
+#include "lab/random.hpp"
 
 namespace grainlab::cli {
 
@@ -39,11 +41,31 @@ fs::path cacheFile(const std::string& scene, int n) {
   return base / "grainlab" / fmt::format("{}-{}.txt", scene, n);
 }
 
+// Scene "lattice": n^3 spheres (n = round(cbrt(N))) on a simple cubic lattice of spacing d50 = 5 mm,
+// radii d50/2 (1 + j) with j uniform in [-1e-3, 1e-3] (seeded), so that about half of the lattice
+// bonds overlap by up to 1e-3 d50: some 1.5 contacts per sphere, as in the isotropically compressed
+// [W] sample, without a preparation whose cost grows faster than N. Walls on the lattice's faces,
+// same law and servos as triaxial-iso. It measures how the cost per particle-step scales with N
+// (10^3 to 10^6) and the memory per particle.
+void buildLattice(int requested, double density, Simulation& sim) {
+  const int n = std::max(2, static_cast<int>(std::lround(std::cbrt(static_cast<double>(requested)))));
+  const double a = 5e-3;
+  lab::Rng rng(12345);
+  sim.particles = Particles{};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double r = 0.5 * a * (1.0 + rng.uniform(-1e-3, 1e-3));
+        sim.particles.addSphere(Vec3((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a), r, density);
+      }
+  sim.box.setBounds(Vec3::Zero(), Vec3::Constant(n * a));
+}
+
 }  // namespace
 
 int runBench(const BenchOptions& opt) {
-  if (opt.scene != "triaxial-iso")
-    throw InputError(fmt::format("bench scene \"{}\" is unknown; available: triaxial-iso", opt.scene));
+  if (opt.scene != "triaxial-iso" && opt.scene != "lattice")
+    throw InputError(fmt::format("bench scene \"{}\" is unknown; available: triaxial-iso, lattice", opt.scene));
   if (opt.particles < 10) throw InputError(fmt::format("--particles = {}: must be >= 10", opt.particles));
   if (opt.steps < 1) throw InputError(fmt::format("--steps = {}: must be >= 1", opt.steps));
   if (opt.threads < 1) throw InputError(fmt::format("--threads = {}: must be >= 1", opt.threads));
@@ -52,7 +74,9 @@ int runBench(const BenchOptions& opt) {
 
   Simulation sim;
   omp_set_num_threads(std::max(2, opt.threads));  // preparation uses what is there
-  if (fs::exists(cache)) {
+  if (opt.scene == "lattice") {
+    buildLattice(opt.particles, config.sample.density, sim);
+  } else if (fs::exists(cache)) {
     io::loadPacking(cache, config.sample.density, sim);
   } else {
     if (!opt.json) fmt::print(stderr, "preparing the {}-particle sample (cached in {})\n", opt.particles, cache.string());
@@ -73,6 +97,9 @@ int runBench(const BenchOptions& opt) {
   for (long i = 0; i < opt.steps; ++i) sim.step();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double rate = static_cast<double>(opt.steps) * sim.particles.size() / seconds;
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const long peakRss = usage.ru_maxrss * 1024L;  // whole process, Linux reports KiB
   nlohmann::json j{{"scene", opt.scene},
                    {"n_particles", sim.particles.size()},
                    {"n_contacts", sim.touchingPairs()},
@@ -80,6 +107,9 @@ int runBench(const BenchOptions& opt) {
                    {"seconds", seconds},
                    {"particle_steps_per_s", rate},
                    {"threads", opt.threads},
+                   {"dt", sim.dt},
+                   {"peak_rss_bytes", peakRss},
+                   {"bytes_per_particle", static_cast<double>(peakRss) / sim.particles.size()},
                    {"neighbor_rebuilds", sim.neighbors.builds - buildsBefore},
                    {"coordination", lab::coordinationNumber(sim)}};
   if (opt.json) {
