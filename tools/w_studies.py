@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""The parameter studies of Widulinski et al. (2009) on the `w-base` preset, run and published.
+
+    /usr/bin/python3 tools/w_studies.py run    [--runs DIR] [--exe build/grainlab] [--jobs 2]
+    /usr/bin/python3 tools/w_studies.py report [--runs DIR] [--docs docs/results]
+
+`run` shears the base case once (2 threads), then one `grainlab sweep` per study over the values
+that differ from the base (1 thread per case, --jobs cases at a time); a study whose sweep.csv
+already lists all its cases as completed is skipped, so an interrupted `run` picks up where it
+stopped. `report` writes docs/results/w-parameter-studies-table.md (one row per case, base
+included in every study) and overlay plots docs/results/w-studies/<study>_q.png and _epsv.png.
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+# (study, key, values, base value, label, how a value is printed)
+BASE = {"contact.beta": 0.15, "contact.eta": 1.0, "contact.friction_deg": 30.0,
+        "contact.young": 30e9, "test.confining_pressure": 100e3, "sample.e0": 0.60}
+STUDIES = [
+    # "densest": frictionless compaction (prep_friction_deg = 0), the densest state of this grading
+    # in a box; [W]'s e0 = 0.50 is below it for spheres against rigid walls.
+    ("e0", "sample.e0", ["densest", 0.60, 0.70, 0.80, 0.90], "e0 target"),
+    ("beta", "contact.beta", [0, 0.10, 0.15, 1, 3, 50], "β"),
+    ("eta", "contact.eta", [0.1, 0.15, 1, 3], "η"),
+    ("mu", "contact.friction_deg", [20, 30, 35, 40], "μ [°]"),
+    ("Ec", "contact.young", [3e9, 30e9], "Ec [GPa]"),
+    ("p", "test.confining_pressure", [100e3, 300e3], "p [kPa]"),
+]
+
+
+def show(key, value):
+    if value == "densest":
+        return "densest"
+    if key == "contact.young":
+        return f"{value / 1e9:g}"
+    if key == "test.confining_pressure":
+        return f"{value / 1e3:g}"
+    return f"{value:g}"
+
+
+def is_base(key, value):
+    return value != "densest" and abs(float(value) - BASE[key]) <= 1e-9 * max(1.0, abs(BASE[key]))
+
+
+def sh(args):
+    print("+", " ".join(args), flush=True)
+    return subprocess.run(args).returncode
+
+
+def completed(directory, n):
+    path = os.path.join(directory, "sweep.csv")
+    if not os.path.exists(path):
+        return False
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return len(rows) == n and all(r["status"] == "completed" for r in rows)
+
+
+def run(opt):
+    t0 = time.time()
+    base = os.path.join(opt.runs, "base")
+    if not os.path.exists(os.path.join(base, "summary.json")):
+        sh([opt.exe, "run", "preset:w-base", "--out", base, "--threads", "2", "--quiet"])
+    for study, key, values, _ in STUDIES:
+        others = [v for v in values if not is_base(key, v)]
+        out = os.path.join(opt.runs, study)
+        numeric = [v for v in others if v != "densest"]
+        if numeric and not completed(out, len(numeric)):
+            sh([opt.exe, "sweep", "preset:w-base", "--vary", f"{key}=" + ",".join(f"{v:g}" for v in numeric),
+                "--jobs", str(opt.jobs), "--threads", "1", "--quiet", "--out", out])
+        if "densest" in others:
+            dense = os.path.join(opt.runs, "e0-densest")
+            if not completed(dense, 1):
+                sh([opt.exe, "sweep", "preset:w-base", "--vary", "sample.prep_friction_deg=0",
+                    "--jobs", "1", "--threads", "2", "--quiet", "--out", dense])
+    print(f"studies done in {time.time() - t0:.0f} s", flush=True)
+
+
+def cases_of(opt, study, key, values):
+    """(value, case directory) for every value of a study, base included, in the study's order."""
+    found = {}
+    sources = [os.path.join(opt.runs, study)]
+    if study == "e0":
+        sources.append(os.path.join(opt.runs, "e0-densest"))
+    for source in sources:
+        path = os.path.join(source, "sweep.csv")
+        if not os.path.exists(path):
+            continue
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                if r["status"] != "completed":
+                    continue
+                if "sample.prep_friction_deg" in r:
+                    found["densest"] = os.path.join(source, r["case"])
+                else:
+                    found[float(r[key])] = os.path.join(source, r["case"])
+    out = []
+    for v in values:
+        if is_base(key, v):
+            out.append((v, os.path.join(opt.runs, "base")))
+        elif v == "densest" and "densest" in found:
+            out.append((v, found["densest"]))
+        elif v != "densest":
+            match = [d for k, d in found.items() if k != "densest" and abs(k - float(v)) <= 1e-9 * max(1, abs(v))]
+            out.append((v, match[0] if match else None))
+        else:
+            out.append((v, None))
+    return out
+
+
+def load(directory):
+    if directory is None or not os.path.exists(os.path.join(directory, "summary.json")):
+        return None, None
+    with open(os.path.join(directory, "summary.json")) as f:
+        summary = json.load(f)
+    with open(os.path.join(directory, "timeseries.csv"), newline="") as f:
+        series = list(csv.DictReader(f))
+    return summary, series
+
+
+def report(opt):
+    plots = os.path.join(opt.docs, "w-studies")
+    os.makedirs(plots, exist_ok=True)
+    lines = ["| study | value | e0 reached | φp [°] | ε1 at peak [%] | φres [°] | ψmax [°] | E [MPa] | "
+             "E50 [MPa] | ν | q/p cs | e cs | I max | σ3 dev. max [%] | wall [s] |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    total_wall = 0.0
+    seen = set()
+    for study, key, values, label in STUDIES:
+        figs = {c: plt.subplots(figsize=(7, 4.5)) for c in ("q", "eps_v")}
+        for value, directory in cases_of(opt, study, key, values):
+            summary, series = load(directory)
+            name = show(key, value) + (" (base)" if is_base(key, value) else "")
+            if summary is None:
+                lines.append(f"| {study} | {name} | not run or failed |" + " |" * 12)
+                continue
+            if directory not in seen:
+                total_wall += summary["wall_seconds"]
+                seen.add(directory)
+            lines.append(
+                f"| {study} | {name} | {summary['e0']:.3f} | {summary['phi_peak_deg']:.1f} | "
+                f"{100 * summary['eps1_at_peak']:.2f} | {summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | "
+                f"{summary['E_MPa']:.0f} | {summary['E50_MPa']:.0f} | {summary['nu']:.2f} | "
+                f"{summary['cs_q_over_p']:.2f} | {summary['cs_void_ratio']:.3f} | "
+                f"{summary['inertial_number_max']:.2e} | {100 * summary['lateral_stress_max_deviation']:.1f} | "
+                f"{summary['wall_seconds']:.0f} |")
+            eps1 = [100 * float(r["eps1"]) for r in series]
+            legend = f"{label} = {show(key, value)}" + (f" (e0 {summary['e0']:.3f})" if study == "e0" else "")
+            figs["q"][1].plot(eps1, [float(r["q"]) / 1e3 for r in series], lw=1.1, label=legend)
+            figs["eps_v"][1].plot(eps1, [100 * float(r["eps_v"]) for r in series], lw=1.1, label=legend)
+        for column, (fig, ax) in figs.items():
+            ax.set_xlabel("axial strain ε1 [%]")
+            ax.set_ylabel("deviator stress q [kPa]" if column == "q" else "volumetric strain εv [%] (contraction +)")
+            ax.set_title(f"[W] study: {label} (others at the base case)")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            target = os.path.join(plots, f"{study}_{'q' if column == 'q' else 'epsv'}.png")
+            fig.savefig(target + ".tmp.png", dpi=100)
+            os.replace(target + ".tmp.png", target)
+            plt.close(fig)
+    lines.append("")
+    lines.append(f"Sum of the distinct cases' wall times: {total_wall:.0f} s ({total_wall / 60:.1f} min of runs; "
+                 "cases ran two at a time on one thread each, the base case alone on two threads).")
+    table = os.path.join(opt.docs, "w-parameter-studies-table.md")
+    with open(table + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(table + ".tmp", table)
+    print("\n".join(lines))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("action", choices=["run", "report"])
+    ap.add_argument("--runs", default="runs/w-studies")
+    ap.add_argument("--exe", default="build/grainlab")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--docs", default="docs/results")
+    opt = ap.parse_args()
+    if opt.action == "run":
+        run(opt)
+    report(opt)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
