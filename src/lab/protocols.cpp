@@ -245,7 +245,7 @@ GrainKinematics Laboratory::currentKinematics() const {
   std::vector<char> active(contacts.size());
   for (std::size_t i = 0; i < contacts.size(); ++i) active[i] = contacts[i] >= 2;
   return grainKinematics(sim_.particles, sim_.particles.referencePosition, boxStrain,
-                         kNeighbourhoodDiameters * d50_, 2.0, active);
+                         kNeighbourhoodDiameters * d50_, config_.output.bandFactor, active);
 }
 
 Record Laboratory::measure(double h0, double v0, const Vec3& l0, double strainRate,

@@ -83,6 +83,7 @@ struct OutputConfig {
   bool savePacking = true;  // packing.txt of the prepared sample, reusable as sample.packing
   double vtkEveryStrain = 0.01;  // ParaView snapshots during shearing; 0 = none
   double checkpointEvery = 0.01;  // checkpoints during shearing, in axial strain; 0 = none
+  double bandFactor = 2.0;  // a grain is in the shear band when its local eq >= this x the box's
 };
 
 struct RunConfig {

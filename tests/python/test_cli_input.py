@@ -87,6 +87,7 @@ BAD = [
     ('sample.grading={ type = "curve", diameters = [2e-3, 8e-3], passing = [10.0, 100.0] }',
      "sample.grading.passing", "10"),
     ('sample.grading={ type = "sieve" }', "sample.grading.type", "sieve"),
+    ("output.band_factor=1", "output.band_factor", "1"),
     ("extra.key=1", "extra", "key"),
 ]
 

@@ -173,4 +173,11 @@ TEST(Kinematics, ShearBandIsDetected) {
     if (z > 0.0205 && z < 0.0275) EXPECT_EQ(k.inBand[i], 1.0) << "z = " << z;
     if (z < 0.015 || z > 0.033) EXPECT_EQ(k.inBand[i], 0.0) << "z = " << z;
   }
+  // The threshold is the band factor: the layer shears ~44/8 = 5.5 times more than the box on
+  // average, so a factor of 20 finds no band and a lower factor finds at least the same grains.
+  EXPECT_GT(k.bandFraction, 0.0);
+  const lab::GrainKinematics strict = lab::grainKinematics(p, p.referencePosition, box, 4.5e-3, 20.0);
+  EXPECT_EQ(strict.bandFraction, 0.0);
+  const lab::GrainKinematics loose = lab::grainKinematics(p, p.referencePosition, box, 4.5e-3, 1.2);
+  EXPECT_GE(loose.bandFraction, k.bandFraction);
 }
