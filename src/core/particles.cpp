@@ -18,6 +18,8 @@ void Particles::addSphere(const Vec3& x, double r, double density) {
   radius.push_back(r);
   mass.push_back(m);
   inertia.push_back(0.4 * m * r * r);
+  invMass.push_back(1.0 / mass.back());
+  invInertia.push_back(1.0 / inertia.back());
   rollingFriction.push_back(0.0);
   sphericity.push_back(1.0);
   referencePosition.push_back(x);
@@ -67,6 +69,12 @@ void Particles::loadState(std::istream& in) {
   getVector(in, radius);
   getVector(in, mass);
   getVector(in, inertia);
+  invMass.resize(mass.size());
+  invInertia.resize(inertia.size());
+  for (std::size_t i = 0; i < mass.size(); ++i) {
+    invMass[i] = 1.0 / mass[i];
+    invInertia[i] = 1.0 / inertia[i];
+  }
   getVector(in, rollingFriction);
   getVector(in, sphericity);
   getVector(in, referencePosition);

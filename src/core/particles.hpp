@@ -20,6 +20,10 @@ struct Particles {
   std::vector<double> radius;   // [m]
   std::vector<double> mass;     // [kg]
   std::vector<double> inertia;  // [kg m^2], 2/5 m R^2 for spheres
+  // 1/m and 1/I, derived from mass and inertia (not saved in checkpoints; rebuilt on load): the
+  // integrator multiplies instead of dividing twice per particle and step.
+  std::vector<double> invMass;
+  std::vector<double> invInertia;
   // Per-grain contact properties ([R]): rolling friction mu_r [-] and the true sphericity it came
   // from (1 where not given).
   std::vector<double> rollingFriction;
@@ -32,6 +36,13 @@ struct Particles {
 
   std::size_t size() const { return position.size(); }
   void addSphere(const Vec3& x, double r, double density);
+  // Overrides a particle's mass and moment of inertia (keeps 1/m and 1/I in step).
+  void setMass(std::size_t i, double m, double inertiaValue) {
+    mass[i] = m;
+    inertia[i] = inertiaValue;
+    invMass[i] = 1.0 / m;
+    invInertia[i] = 1.0 / inertiaValue;
+  }
   // Starts the kinematic record anew (e.g. at the start of shearing).
   void resetKinematicReference();
   // Angle [rad] of the composed rotation of particle i since its reference orientation.

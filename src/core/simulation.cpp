@@ -23,6 +23,7 @@ void Simulation::step() {
   if (rebuildDue_ || neighbors.wallsMoved(box)) {
     neighbors.build(particles, box);
     rebuildDue_ = false;
+    slotsStale_ = true;
   }
   computeContacts();
   gatherForces();
@@ -48,6 +49,10 @@ void Simulation::computeContacts() {
   // Slip and rolling dissipation, summed per fixed chunk (see parallel.hpp); pairs first, then
   // wall contacts. Chunks are scheduled dynamically: only touching pairs run the contact law.
   ChunkedSums pairSums(nPairs, 2), wallSums(nWall, 2);
+  // A pair that was apart and still is keeps its zero slots, so it is skipped without a write;
+  // after a rebuild (pairs renumbered) or a load every slot is written once.
+  const bool writeAll = slotsStale_;
+  slotsStale_ = false;
 
 #pragma omp parallel
   {
@@ -61,6 +66,7 @@ void Simulation::computeContacts() {
     const double dist2 = branch.squaredNorm();
     const double reach = rad[a] + rad[b];
     if (dist2 >= reach * reach) {
+      if (!h.touching && !writeAll) continue;
       h = contact::ContactHistory{};
       pairForce[p].setZero();
       pairTorqueA[p].setZero();
@@ -104,6 +110,7 @@ void Simulation::computeContacts() {
     planePoint[wall.axis] = wall.position;
     const geometry::ContactGeometry g = geometry::spherePlane(x[i], rad[i], planePoint, n);
     if (g.overlap <= 0.0) {
+      if (!h.touching && !writeAll) continue;
       h = contact::ContactHistory{};
       wallForce[c].setZero();
       wallTorque[c].setZero();
@@ -138,33 +145,32 @@ void Simulation::computeContacts() {
   energy.rolling += pairSums.total(1) + wallSums.total(1);
 }
 
-void Simulation::gatherForces() {
-  const std::size_t n = particles.size();
-  auto& f = particles.force;
-  auto& t = particles.torque;
+void Simulation::gatherParticle(std::size_t i) {
   // Each particle sums its own contacts in a fixed order: no races, and the sums do not depend on
   // the number of threads (bit-identical results for any thread count).
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-    for (std::uint32_t s = neighbors.incidentStart[i]; s < neighbors.incidentStart[i + 1]; ++s) {
-      const std::uint32_t e = neighbors.incident[s];
-      const std::uint32_t p = e >> 1;
-      if (e & 1u) {
-        fi += pairForce[p];
-        ti += pairTorqueB[p];
-      } else {
-        fi -= pairForce[p];
-        ti += pairTorqueA[p];
-      }
+  Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+  for (std::uint32_t s = neighbors.incidentStart[i]; s < neighbors.incidentStart[i + 1]; ++s) {
+    const std::uint32_t e = neighbors.incident[s];
+    const std::uint32_t p = e >> 1;
+    if (e & 1u) {
+      fi += pairForce[p];
+      ti += pairTorqueB[p];
+    } else {
+      fi -= pairForce[p];
+      ti += pairTorqueA[p];
     }
-    for (std::uint32_t c = neighbors.wallStart[i]; c < neighbors.wallStart[i + 1]; ++c) {
-      fi += wallForce[c];
-      ti += wallTorque[c];
-    }
-    f[i] = fi;
-    t[i] = ti;
   }
+  for (std::uint32_t c = neighbors.wallStart[i]; c < neighbors.wallStart[i + 1]; ++c) {
+    fi += wallForce[c];
+    ti += wallTorque[c];
+  }
+  particles.force[i] = fi;
+  particles.torque[i] = ti;
+}
+
+void Simulation::gatherForces() {
+  // The particles' own sums are done in integrate() (one pass over the particles instead of two,
+  // one parallel region less per step); here only the walls' forces, which the servos need first.
   for (Wall& wall : box.walls) {
     wall.normalForce = 0.0;
     wall.contactStiffness = 0.0;
@@ -224,6 +230,7 @@ void Simulation::integrate() {
   for (std::size_t chunk = 0; chunk < dampingWork.chunks(); ++chunk) {
   double work = 0.0;
   for (std::size_t i = dampingWork.begin(chunk); i < dampingWork.end(chunk); ++i) {
+    gatherParticle(i);
     // Cundall local damping per component, against the sign of the current (mid-step) velocity.
     Vec3 f = particles.force[i] + particles.mass[i] * gravity;
     Vec3 t = particles.torque[i];
@@ -233,8 +240,8 @@ void Simulation::integrate() {
       td[k] = -alpha * std::copysign(std::abs(t[k]), w[i][k]) * (w[i][k] != 0.0);
     }
     const Vec3 vOld = v[i], wOld = w[i];
-    v[i] += (f + fd) * (h / particles.mass[i]);
-    w[i] += (t + td) * (h / particles.inertia[i]);
+    v[i] += (f + fd) * (h * particles.invMass[i]);
+    w[i] += (t + td) * (h * particles.invInertia[i]);
     // Work of the damping forces over the step, with the mean of old and new velocities.
     work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
     x[i] += v[i] * h;
@@ -242,7 +249,12 @@ void Simulation::integrate() {
     if (wNorm > 0.0) {
       // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
       const Vec3 half = 0.5 * h * w[i];
-      q[i] = (Quat(1.0, half.x(), half.y(), half.z()) * q[i]).normalized();
+      Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
+      // |qn|^2 = 1 + eps with eps ~ |w dt|^2 / 4 (~1e-10): 1/sqrt(1 + eps) by its series
+      // 1 - eps/2 + 3 eps^2/8, exact to round-off below 1e-6; the square root otherwise.
+      const double eps = qn.coeffs().squaredNorm() - 1.0;
+      qn.coeffs() *= std::abs(eps) < 1e-6 ? 1.0 - 0.5 * eps + 0.375 * eps * eps : 1.0 / std::sqrt(1.0 + eps);
+      q[i] = qn;
       particles.rotationPath[i] += wNorm * h;
     }
     if (!xBuild.empty()) maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
@@ -310,6 +322,7 @@ void Simulation::loadState(std::istream& in) {
   getVector(in, wallForce);
   getVector(in, wallTorque);
   get(in, rebuildDue_);
+  slotsStale_ = true;
 }
 
 std::size_t Simulation::touchingPairs() const {

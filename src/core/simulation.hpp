@@ -2,7 +2,8 @@
 // The DEM engine for spheres in a box of rigid walls. One call of step() runs the pipeline
 //
 //   broad phase (Verlet list, rebuilt when due) -> narrow phase + contact law (per pair, parallel)
-//   -> force gather (per particle, fixed order) -> walls & servos -> integrator (leapfrog + damping)
+//   -> wall forces & servos -> per particle: force gather (fixed order) + integrator (leapfrog +
+//   damping), fused in one parallel pass
 //
 // Laboratory protocols drive it from outside (recorders and stop checks between steps).
 #include <string>
@@ -76,9 +77,11 @@ class Simulation {
  private:
   void computeContacts();
   void gatherForces();
+  void gatherParticle(std::size_t i);
   void updateWalls();
   void integrate();
   bool rebuildDue_ = true;
+  bool slotsStale_ = true;  // pair/wall force slots not yet written since the last rebuild or load
 };
 
 }  // namespace grainlab

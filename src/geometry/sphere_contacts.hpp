@@ -19,7 +19,7 @@ struct ContactGeometry {
 inline ContactGeometry sphereSphere(const Vec3& branch, double dist2, double rA, double rB) {
   const double dist = std::sqrt(dist2);
   ContactGeometry g;
-  g.normal = branch / dist;
+  g.normal = branch * (1.0 / dist);
   g.overlap = rA + rB - dist;
   // C = X_A + (R_A - U/2) N
   g.branchA = (rA - 0.5 * g.overlap) * g.normal;

@@ -21,8 +21,7 @@ TEST(FreeCluster, NewtonThirdLawAndAngularMomentum) {
     sim.particles.angularVelocity.back() = Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
     // Massive bodies keep their prescribed motion, so the contacts stay closed while their shear
     // and moment springs load; the balance of the contact forces does not depend on the masses.
-    sim.particles.mass.back() = 1e30;
-    sim.particles.inertia.back() = 1e30;
+    sim.particles.setMass(sim.particles.size() - 1, 1e30, 1e30);
   }
   sim.initialise();
   sim.dt = 1e-5;

@@ -59,8 +59,7 @@ TEST(ShearForce, RigidRotationOfLoadedContact) {
   sim.particles.addSphere(Vec3(-(R - 0.5 * overlap), 0, 0), R, 2600.0);
   sim.particles.addSphere(Vec3(R - 0.5 * overlap, 0, 0), R, 2600.0);
   for (std::size_t i = 0; i < 2; ++i) {  // immovable by forces: the test prescribes the motion
-    sim.particles.mass[i] = 1e30;
-    sim.particles.inertia[i] = 1e30;
+    sim.particles.setMass(i, 1e30, 1e30);
   }
   sim.initialise();
   sim.dt = 1e-7;
