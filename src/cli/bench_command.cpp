@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -21,6 +23,20 @@ namespace grainlab::cli {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Peak resident set of this process [bytes]: VmHWM of /proc/self/status. getrusage's ru_maxrss
+// is not used: Linux carries it across exec, so a bench started from a large parent (a Python
+// driver with matplotlib loaded) would report the parent's peak.
+long peakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::atol(line.c_str() + 6) * 1024L;  // kB
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss * 1024L;
+}
 
 // The [W] set-up: diameters 2–8 mm (straight passing curve by mass), Ec 30 GPa, nu 0.3, mu 30 deg,
 // beta 0.15, eta 1, rho 2600, alpha 0.3, 100 kPa.
@@ -97,9 +113,7 @@ int runBench(const BenchOptions& opt) {
   for (long i = 0; i < opt.steps; ++i) sim.step();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double rate = static_cast<double>(opt.steps) * sim.particles.size() / seconds;
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  const long peakRss = usage.ru_maxrss * 1024L;  // whole process, Linux reports KiB
+  const long peakRss = peakResidentBytes();
   nlohmann::json j{{"scene", opt.scene},
                    {"n_particles", sim.particles.size()},
                    {"n_contacts", sim.touchingPairs()},
