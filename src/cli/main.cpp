@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   sweepCmd->add_option("--vary", sweep.vary, "KEY=V1,V2,... (repeat for a grid)")->required()->allow_extra_args(false);
   sweepCmd->add_option("--set", sweep.overrides, "override applied to every case")->allow_extra_args(false);
   sweepCmd->add_option("--jobs", sweep.jobs, "cases run at once")->capture_default_str();
-  sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: solver.threads)");
+  sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)");
   sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)");
   sweepCmd->add_flag("--quiet", sweep.quiet, "no progress output");
 

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -122,6 +123,18 @@ int runSweep(const SweepOptions& opt) {
     std::string name;
     int status = -1;
   };
+  // Several cases at once share the cores: without --threads each gets cores / jobs threads.
+  // OpenMP on more threads than cores is not just slower but pathological (each step's barriers
+  // wait for descheduled threads: 10-40x slower measured on 2 cores); results do not depend on
+  // the thread count, so this changes only the speed.
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  int threadsPerCase = opt.threads;
+  if (threadsPerCase <= 0 && opt.jobs > 1) threadsPerCase = std::max(1, cores / opt.jobs);
+  if (threadsPerCase > 0 && threadsPerCase * opt.jobs > cores)
+    std::fprintf(stderr,
+                 "grainlab: warning: --jobs %d x --threads %d = %d threads on %d cores; oversubscribed OpenMP "
+                 "runs many times slower\n",
+                 opt.jobs, threadsPerCase, opt.jobs * threadsPerCase, cores);
   std::vector<Job> jobs(cases.size());
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0, done = 0;
@@ -141,7 +154,7 @@ int runSweep(const SweepOptions& opt) {
     while (next < cases.size() && running.size() < static_cast<std::size_t>(opt.jobs)) {
       jobs[next].name = caseName(next, cases[next]);
       std::vector<std::string> args{self, "run", opt.config, "--out", (out / jobs[next].name).string(), "--quiet"};
-      if (opt.threads > 0) args.insert(args.end(), {"--threads", std::to_string(opt.threads)});
+      if (threadsPerCase > 0) args.insert(args.end(), {"--threads", std::to_string(threadsPerCase)});
       for (const auto& s : opt.overrides) args.insert(args.end(), {"--set", s});
       for (const auto& [k, v] : cases[next]) args.insert(args.end(), {"--set", k + "=" + v});
       std::vector<char*> argv;
