@@ -3,12 +3,15 @@
 
     /usr/bin/python3 tools/w_studies.py run    [--runs DIR] [--exe build/grainlab] [--jobs 2]
     /usr/bin/python3 tools/w_studies.py report [--runs DIR] [--docs docs/results]
+    /usr/bin/python3 tools/w_studies.py size   [--size-runs runs/w-size] [--sizes 2000,8000]
 
 `run` shears the base case once (2 threads), then one `grainlab sweep` per study over the values
 that differ from the base (1 thread per case, --jobs cases at a time); a study whose sweep.csv
 already lists all its cases as completed is skipped, so an interrupted `run` picks up where it
 stopped. `report` writes docs/results/w-parameter-studies-table.md (one row per case, base
 included in every study) and overlay plots docs/results/w-studies/<study>_q.png and _epsv.png.
+`size` runs the base case alone on 2 threads at each number of spheres (skipping those done) and
+writes docs/results/w-size-table.md and docs/results/w-studies/size_q.png, size_epsv.png.
 """
 import argparse
 import csv
@@ -179,14 +182,64 @@ def report(opt):
     print("\n".join(lines))
 
 
+def size(opt):
+    sizes = [int(n) for n in opt.sizes.split(",")]
+    rows = ["| spheres | e0 reached | φp [°] | ε1 at peak [%] | φres [°] | ψmax [°] | E [MPa] | q/p cs | e cs | "
+            "σ3 dev. max [%] | rotation in / outside band [°] | wall [s] |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    figs = {c: plt.subplots(figsize=(7, 4.5)) for c in ("q", "eps_v")}
+    for n in sizes:
+        out = os.path.join(opt.size_runs, f"n{n}")
+        if not os.path.exists(os.path.join(out, "summary.json")):
+            sh([opt.exe, "run", "preset:w-base", "--set", f"sample.n_particles={n}", "--out", out, "--threads", "2",
+                "--quiet"])
+        summary, series = load(out)
+        if summary is None:
+            rows.append(f"| {n} | failed |" + " |" * 10)
+            continue
+        rows.append(f"| {n} | {summary['e0']:.3f} | {summary['phi_peak_deg']:.1f} | {100 * summary['eps1_at_peak']:.2f} | "
+                    f"{summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | {summary['E_MPa']:.0f} | "
+                    f"{summary['cs_q_over_p']:.2f} | {summary['cs_void_ratio']:.3f} | "
+                    f"{100 * summary['lateral_stress_max_deviation']:.1f} | "
+                    f"{summary['rotation_band_mean_deg']:.1f} / {summary['rotation_outside_band_mean_deg']:.1f} | "
+                    f"{summary['wall_seconds']:.0f} |")
+        eps1 = [100 * float(r["eps1"]) for r in series]
+        legend = f"{n} spheres (e0 {summary['e0']:.3f})"
+        figs["q"][1].plot(eps1, [float(r["q"]) / 1e3 for r in series], lw=1.1, label=legend)
+        figs["eps_v"][1].plot(eps1, [100 * float(r["eps_v"]) for r in series], lw=1.1, label=legend)
+    plots = os.path.join(opt.docs, "w-studies")
+    os.makedirs(plots, exist_ok=True)
+    for column, (fig, ax) in figs.items():
+        ax.set_xlabel("axial strain ε1 [%]")
+        ax.set_ylabel("deviator stress q [kPa]" if column == "q" else "volumetric strain εv [%] (contraction +)")
+        ax.set_title("[W] base case: number of spheres")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        target = os.path.join(plots, f"size_{'q' if column == 'q' else 'epsv'}.png")
+        fig.savefig(target + ".tmp.png", dpi=100)
+        os.replace(target + ".tmp.png", target)
+        plt.close(fig)
+    table = os.path.join(opt.docs, "w-size-table.md")
+    with open(table + ".tmp", "w") as f:
+        f.write("\n".join(rows) + "\n")
+    os.replace(table + ".tmp", table)
+    print("\n".join(rows))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("action", choices=["run", "report"])
+    ap.add_argument("action", choices=["run", "report", "size"])
+    ap.add_argument("--size-runs", default="runs/w-size")
+    ap.add_argument("--sizes", default="2000,8000")
     ap.add_argument("--runs", default="runs/w-studies")
     ap.add_argument("--exe", default="build/grainlab")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--docs", default="docs/results")
     opt = ap.parse_args()
+    if opt.action == "size":
+        size(opt)
+        return 0
     if opt.action == "run":
         run(opt)
     report(opt)
