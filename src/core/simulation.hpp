@@ -25,7 +25,7 @@ namespace grainlab {
 // term learns that speed and removes the lag. Speed is capped; a wall with no contact approaches at
 // the cap.
 struct ServoSettings {
-  double gain = 0.5;              // [-], fraction of u per step
+  double gain = 0.8;              // [-], fraction of u per step
   double integralSteps = 100.0;   // [steps]; 0 disables the integral term
   double maxSpeed = 0.5;          // [m/s]
 };

@@ -69,7 +69,7 @@ struct SolverConfig {
   int threads = 2;
   double unbalancedTolerance = 0.01;  // quasi-static threshold for the unbalanced-force ratio
   double stressTolerance = 0.01;      // relative, for isotropic equilibrium
-  double servoGain = 0.5;
+  double servoGain = 0.8;
   double servoIntegralSteps = 100.0;
   double servoMaxSpeed = 0.5;  // [m/s]
   double skinFraction = 0.2;   // Verlet skin as a fraction of the smallest radius
