@@ -4,6 +4,7 @@
     /usr/bin/python3 tools/w_studies.py run    [--runs DIR] [--exe build/grainlab] [--jobs 2]
     /usr/bin/python3 tools/w_studies.py report [--runs DIR] [--docs docs/results]
     /usr/bin/python3 tools/w_studies.py size   [--size-runs runs/w-size] [--sizes 2000,8000]
+    /usr/bin/python3 tools/w_studies.py compare --runs DIR_A --runs-b DIR_B [--out FILE]
 
 `run` shears the base case once (2 threads), then one `grainlab sweep` per study over the values
 that differ from the base (1 thread per case, --jobs cases at a time); a study whose sweep.csv
@@ -12,6 +13,8 @@ stopped. `report` writes docs/results/w-parameter-studies-table.md (one row per 
 included in every study) and overlay plots docs/results/w-studies/<study>_q.png and _epsv.png.
 `size` runs the base case alone on 2 threads at each number of spheres (skipping those done) and
 writes docs/results/w-size-table.md and docs/results/w-studies/size_q.png, size_epsv.png.
+`compare` puts two complete runs of the studies (e.g. two code versions or seeds) side by side,
+case by case, with the mean absolute difference of each quantity: the scatter of a single run.
 """
 import argparse
 import csv
@@ -227,9 +230,44 @@ def size(opt):
     print("\n".join(rows))
 
 
+def compare(opt):
+    keys = [("e0", "e0", 3, 1), ("φp", "phi_peak_deg", 1, 1), ("φres", "phi_res_deg", 1, 1),
+            ("ψmax", "psi_max_deg", 1, 1), ("E", "E_MPa", 0, 1), ("σ3 dev. %", "lateral_stress_max_deviation", 1, 100),
+            ("wall s", "wall_seconds", 0, 1)]
+    head = "| study | value | " + " | ".join(f"{k[0]} A / B" for k in keys) + " |"
+    lines = [head, "|---|---|" + "---:|" * len(keys)]
+    diffs = {k[1]: [] for k in keys}
+    seen = set()
+    for study, key, values, _ in STUDIES:
+        a_cases = cases_of(argparse.Namespace(runs=opt.runs), study, key, values)
+        b_cases = cases_of(argparse.Namespace(runs=opt.runs_b), study, key, values)
+        for (value, da), (_, db) in zip(a_cases, b_cases):
+            sa, _ = load(da)
+            sb, _ = load(db)
+            name = show(key, value) + (" (base)" if is_base(key, value) else "")
+            if sa is None or sb is None:
+                lines.append(f"| {study} | {name} | missing |" + " |" * (len(keys) - 1))
+                continue
+            cells = []
+            for _, k, digits, scale in keys:
+                cells.append(f"{scale * sa[k]:.{digits}f} / {scale * sb[k]:.{digits}f}")
+                if (da, db) not in seen:
+                    diffs[k].append(abs(scale * (sa[k] - sb[k])))
+            seen.add((da, db))
+            lines.append(f"| {study} | {name} | " + " | ".join(cells) + " |")
+    lines.append("| mean abs. difference | | " + " | ".join(
+        f"{sum(diffs[k[1]]) / max(1, len(diffs[k[1]])):.{max(k[2], 1)}f}" for k in keys) + " |")
+    with open(opt.out + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(opt.out + ".tmp", opt.out)
+    print("\n".join(lines))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("action", choices=["run", "report", "size"])
+    ap.add_argument("action", choices=["run", "report", "size", "compare"])
+    ap.add_argument("--runs-b", default="runs/w-studies-v2")
+    ap.add_argument("--out", default="docs/results/w-parameter-studies-compare.md")
     ap.add_argument("--size-runs", default="runs/w-size")
     ap.add_argument("--sizes", default="2000,8000")
     ap.add_argument("--runs", default="runs/w-studies")
@@ -239,6 +277,9 @@ def main():
     opt = ap.parse_args()
     if opt.action == "size":
         size(opt)
+        return 0
+    if opt.action == "compare":
+        compare(opt)
         return 0
     if opt.action == "run":
         run(opt)
