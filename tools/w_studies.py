@@ -134,6 +134,29 @@ def load(directory):
     return summary, series
 
 
+def finish_overlays(figs, title, plots, stem):
+    """Labels, legend and atomic PNG save of a q-eps1 / eps_v-eps1 figure pair."""
+    for column, (fig, ax) in figs.items():
+        ax.set_xlabel("axial strain ε1 [%]")
+        ax.set_ylabel("deviator stress q [kPa]" if column == "q" else "volumetric strain εv [%] (contraction +)")
+        ax.set_title(title)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        target = os.path.join(plots, f"{stem}_{'q' if column == 'q' else 'epsv'}.png")
+        fig.savefig(target + ".tmp.png", dpi=100)
+        os.replace(target + ".tmp.png", target)
+        plt.close(fig)
+
+
+def write_table(path, lines):
+    """Writes a markdown table atomically and prints it."""
+    with open(path + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(path + ".tmp", path)
+    print("\n".join(lines))
+
+
 def report(opt):
     plots = os.path.join(opt.docs, "w-studies")
     os.makedirs(plots, exist_ok=True)
@@ -164,25 +187,11 @@ def report(opt):
             legend = f"{label} = {show(key, value)}" + (f" (e0 {summary['e0']:.3f})" if study == "e0" else "")
             figs["q"][1].plot(eps1, [float(r["q"]) / 1e3 for r in series], lw=1.1, label=legend)
             figs["eps_v"][1].plot(eps1, [100 * float(r["eps_v"]) for r in series], lw=1.1, label=legend)
-        for column, (fig, ax) in figs.items():
-            ax.set_xlabel("axial strain ε1 [%]")
-            ax.set_ylabel("deviator stress q [kPa]" if column == "q" else "volumetric strain εv [%] (contraction +)")
-            ax.set_title(f"[W] study: {label} (others at the base case)")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=8)
-            fig.tight_layout()
-            target = os.path.join(plots, f"{study}_{'q' if column == 'q' else 'epsv'}.png")
-            fig.savefig(target + ".tmp.png", dpi=100)
-            os.replace(target + ".tmp.png", target)
-            plt.close(fig)
+        finish_overlays(figs, f"[W] study: {label} (others at the base case)", plots, study)
     lines.append("")
     lines.append(f"Sum of the distinct cases' wall times: {total_wall:.0f} s ({total_wall / 60:.1f} min of runs; "
                  "cases ran two at a time on one thread each, the base case alone on two threads).")
-    table = os.path.join(opt.docs, "w-parameter-studies-table.md")
-    with open(table + ".tmp", "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(table + ".tmp", table)
-    print("\n".join(lines))
+    write_table(os.path.join(opt.docs, "w-parameter-studies-table.md"), lines)
 
 
 def size(opt):
@@ -212,22 +221,8 @@ def size(opt):
         figs["eps_v"][1].plot(eps1, [100 * float(r["eps_v"]) for r in series], lw=1.1, label=legend)
     plots = os.path.join(opt.docs, "w-studies")
     os.makedirs(plots, exist_ok=True)
-    for column, (fig, ax) in figs.items():
-        ax.set_xlabel("axial strain ε1 [%]")
-        ax.set_ylabel("deviator stress q [kPa]" if column == "q" else "volumetric strain εv [%] (contraction +)")
-        ax.set_title("[W] base case: number of spheres")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        target = os.path.join(plots, f"size_{'q' if column == 'q' else 'epsv'}.png")
-        fig.savefig(target + ".tmp.png", dpi=100)
-        os.replace(target + ".tmp.png", target)
-        plt.close(fig)
-    table = os.path.join(opt.docs, "w-size-table.md")
-    with open(table + ".tmp", "w") as f:
-        f.write("\n".join(rows) + "\n")
-    os.replace(table + ".tmp", table)
-    print("\n".join(rows))
+    finish_overlays(figs, "[W] base case: number of spheres", plots, "size")
+    write_table(os.path.join(opt.docs, "w-size-table.md"), rows)
 
 
 def compare(opt):
@@ -257,10 +252,7 @@ def compare(opt):
             lines.append(f"| {study} | {name} | " + " | ".join(cells) + " |")
     lines.append("| mean abs. difference | | " + " | ".join(
         f"{sum(diffs[k[1]]) / max(1, len(diffs[k[1]])):.{max(k[2], 1)}f}" for k in keys) + " |")
-    with open(opt.out + ".tmp", "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(opt.out + ".tmp", opt.out)
-    print("\n".join(lines))
+    write_table(opt.out, lines)
 
 
 def main():

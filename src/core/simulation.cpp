@@ -26,7 +26,7 @@ void Simulation::step() {
     slotsStale_ = true;
   }
   computeContacts();
-  gatherForces();
+  sumWallForces();
   updateWalls();
   integrate();
   ++stepCount;
@@ -168,7 +168,7 @@ void Simulation::gatherParticle(std::size_t i) {
   particles.torque[i] = ti;
 }
 
-void Simulation::gatherForces() {
+void Simulation::sumWallForces() {
   // The particles' own sums are done in integrate() (one pass over the particles instead of two,
   // one parallel region less per step); here only the walls' forces, which the servos need first.
   for (Wall& wall : box.walls) {

@@ -12,23 +12,10 @@
 #include "contact/models.hpp"
 #include "core/neighbor_list.hpp"
 #include "core/particles.hpp"
+#include "core/servo_settings.hpp"
 #include "core/walls.hpp"
 
 namespace grainlab {
-
-// Stiffness-based proportional-integral wall servo. The error (sigma_target - sigma) times the wall
-// area over the summed Kn of the wall's contacts is the displacement u that would cancel the error
-// if only those contacts deformed (the PFC / YADE TriaxialStressController scaling, which keeps the
-// loop stable whatever the stiffness). Each step the wall moves by gain*u plus an integral term that
-// accumulates gain*u/integralSteps: a proportional servo alone lags a wall that must keep moving
-// (a dilating sample under a constant sigma3) by an error proportional to its speed; the integral
-// term learns that speed and removes the lag. Speed is capped; a wall with no contact approaches at
-// the cap.
-struct ServoSettings {
-  double gain = 0.8;              // [-], fraction of u per step
-  double integralSteps = 100.0;   // [steps]; 0 disables the integral term
-  double maxSpeed = 0.5;          // [m/s]
-};
 
 // Cumulative energy terms tracked by the engine [J] (PHYSICS.md §7.6, partial).
 struct EnergyLedger {
@@ -76,7 +63,7 @@ class Simulation {
 
  private:
   void computeContacts();
-  void gatherForces();
+  void sumWallForces();
   void gatherParticle(std::size_t i);
   void updateWalls();
   void integrate();

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/servo_settings.hpp"
+
 namespace grainlab::lab {
 
 struct GradingConfig {
@@ -69,9 +71,9 @@ struct SolverConfig {
   int threads = 2;
   double unbalancedTolerance = 0.01;  // quasi-static threshold for the unbalanced-force ratio
   double stressTolerance = 0.01;      // relative, for isotropic equilibrium
-  double servoGain = 0.8;
-  double servoIntegralSteps = 100.0;
-  double servoMaxSpeed = 0.5;  // [m/s]
+  double servoGain = ServoSettings{}.gain;
+  double servoIntegralSteps = ServoSettings{}.integralSteps;
+  double servoMaxSpeed = ServoSettings{}.maxSpeed;  // [m/s]
   double skinFraction = 0.2;   // Verlet skin as a fraction of the smallest radius
   long maxSteps = 50'000'000;  // safety limit per phase
 };
