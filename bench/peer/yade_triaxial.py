@@ -43,17 +43,16 @@ CSV columns (compression / contraction positive, stresses in Pa):
 
 import argparse
 import math
+import os
 import sys
 import time
 
-import yade
-from yade import O, utils
-from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, CohFrictMat, ForceResetter,
-                          Ig2_Box_Sphere_ScGeom6D, Ig2_Sphere_Sphere_ScGeom6D,
-                          InsertionSortCollider, InteractionLoop,
-                          Ip2_CohFrictMat_CohFrictMat_CohFrictPhys,
-                          Law2_ScGeom6D_CohFrictPhys_CohesionMoment, NewtonIntegrator, PyRunner,
-                          TriaxialStressController)
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: the script's folder
+import yade  # noqa: E402
+from yade import O, utils  # noqa: E402
+from yade.wrapper import PyRunner, TriaxialStressController  # noqa: E402
+import yade_scene  # noqa: E402
+from yade_scene import BETA, YOUNG  # noqa: E402
 
 # ---------------------------------------------------------------------------------------------
 # Command line
@@ -81,62 +80,15 @@ parser.add_argument('--wall-young', type=float, default=None,
 args = parser.parse_args(sys.argv[1:])
 
 # ---------------------------------------------------------------------------------------------
-# Parameters (grainlab 'kozicki-donze' defaults)
+# Scene (yade_scene.py): the [W] parameters, the packing, materials, six Box walls whose inner faces
+# lie on the given planes (ids 0..5 = xlo, xhi, ylo, yhi, zlo, zhi, TriaxialStressController's
+# default numbering), then the spheres.
 # ---------------------------------------------------------------------------------------------
-YOUNG = 30e9            # E [Pa]
-KS_KN = 0.3             # ks/kn (YADE 'poisson')
-FRICTION_DEG = 30.0     # interparticle friction angle
-BETA = 0.15             # alphaKr = alphaKtw
-ETA = 1.0               # etaRoll = etaTwist
-DENSITY = 2600.0        # [kg/m3]
-DAMPING = 0.3           # Cundall non-viscous damping
 moments = not args.no_moments
-wallYoung = args.wall_young if args.wall_young is not None else 1e6 * YOUNG
-
-# ---------------------------------------------------------------------------------------------
-# Packing
-# ---------------------------------------------------------------------------------------------
-with open(args.packing) as f:
-    lines = [l for l in f if l.strip() and not l.lstrip().startswith('#')]
-planes = [float(v) for v in lines[0].split()]          # xlo xhi ylo yhi zlo zhi
-spheresIn = [tuple(float(v) for v in l.split()[:4]) for l in lines[1:]]
+planes, spheresIn = yade_scene.read_packing(args.packing)
 nSpheres = len(spheresIn)
-
-# ---------------------------------------------------------------------------------------------
-# Materials
-# ---------------------------------------------------------------------------------------------
-sphereMat = O.materials.append(CohFrictMat(
-    young=YOUNG, poisson=KS_KN, density=DENSITY, frictionAngle=math.radians(FRICTION_DEG),
-    isCohesive=False, normalCohesion=-1, shearCohesion=-1,
-    momentRotationLaw=moments,
-    alphaKr=BETA if moments else 0.0, alphaKtw=BETA if moments else 0.0,
-    etaRoll=ETA if moments else 0.0, etaTwist=ETA if moments else 0.0,
-    label='spheres'))
-wallMat = O.materials.append(CohFrictMat(
-    young=wallYoung, poisson=KS_KN, density=0.0, frictionAngle=0.0,
-    isCohesive=False, momentRotationLaw=False, alphaKr=0.0, alphaKtw=0.0,
-    etaRoll=0.0, etaTwist=0.0, label='walls'))
-
-# ---------------------------------------------------------------------------------------------
-# Walls: six Box bodies whose inner faces lie on the given planes. Ids 0..5 = xlo, xhi, ylo,
-# yhi, zlo, zhi, which is TriaxialStressController's default numbering (left, right, bottom,
-# top, back, front). All boxes have the same thickness (the controller needs it).
-# ---------------------------------------------------------------------------------------------
-L = [planes[2 * a + 1] - planes[2 * a] for a in range(3)]
-mid = [0.5 * (planes[2 * a] + planes[2 * a + 1]) for a in range(3)]
-thick = 0.1 * min(L)
-for axis in range(3):
-    for side in (0, 1):                                  # 0: lower plane, 1: upper plane
-        center = list(mid)
-        center[axis] = planes[2 * axis + side] + (thick / 2 if side else -thick / 2)
-        ext = [1.5 * max(L)] * 3                         # wide enough for lateral bulging
-        ext[axis] = thick / 2
-        O.bodies.append(utils.box(center=center, extents=ext, fixed=True, wire=True,
-                                  material=wallMat))
+thick = yade_scene.build(planes, spheresIn, moments=moments, wall_young=args.wall_young)
 WALL_IDS = list(range(6))
-for r, x, y, z in spheresIn:
-    O.bodies.append(utils.sphere((x, y, z), r, material=sphereMat))
-sphereIds = [b.id for b in O.bodies if b.id >= 6]
 
 
 def plane(i):
@@ -183,18 +135,7 @@ triax = TriaxialStressController(
 
 shearRunner = PyRunner(iterPeriod=1, command='shearStep()', dead=True, label='shearRunner')
 
-O.engines = [
-    ForceResetter(),
-    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-    InteractionLoop(
-        [Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Box_Sphere_ScGeom6D()],
-        [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
-        [Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True,
-                                                   always_use_moment_law=True, label='law')]),
-    triax,
-    shearRunner,
-    NewtonIntegrator(damping=DAMPING, gravity=(0, 0, 0)),
-]
+O.engines = yade_scene.engines(triax, extra=[shearRunner], law_label='law')
 O.dt = args.dt_factor * utils.PWaveTimeStep()
 
 # ---------------------------------------------------------------------------------------------
