@@ -110,7 +110,7 @@ int runBench(const BenchOptions& opt) {
   }
   omp_set_num_threads(opt.threads);
   for (int i = 0; i < 200; ++i) sim.step();  // rebuild contacts and their history
-  const long buildsBefore = sim.neighbors.builds;
+  const long buildsBefore = sim.broadPhase.builds;
   const auto t0 = std::chrono::steady_clock::now();
   for (long i = 0; i < opt.steps; ++i) sim.step();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -126,7 +126,7 @@ int runBench(const BenchOptions& opt) {
                    {"dt", sim.dt},
                    {"peak_rss_bytes", peakRss},
                    {"bytes_per_particle", static_cast<double>(peakRss) / sim.particles.size()},
-                   {"neighbor_rebuilds", sim.neighbors.builds - buildsBefore},
+                   {"neighbor_rebuilds", sim.broadPhase.builds - buildsBefore},
                    {"coordination", lab::coordinationNumber(sim)}};
   if (opt.json) {
     fmt::print("{}\n", j.dump());

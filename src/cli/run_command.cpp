@@ -39,7 +39,8 @@ json gradingJson(const lab::GradingStats& g) {
 }
 
 json equilibriumJson(const lab::EquilibriumState& s) {
-  return {{"wall_stress", {s.wallStress[0], s.wallStress[1], s.wallStress[2]}},
+  return {{"wall_stress", {s.boundaryStress[0], s.boundaryStress[1], s.boundaryStress[2]}},
+          {"coordination", s.coordination},
           {"contact_stress", {s.contactStress(0, 0), s.contactStress(1, 1), s.contactStress(2, 2)}},
           {"unbalanced", s.unbalanced},
           {"void_ratio", s.voidRatio}};
@@ -83,18 +84,26 @@ class RunSession {
         lab_(config, [this](const std::string& phase, double f, long steps) { progress_.update(phase, f, steps); }) {
     if (config.output.vtkEveryStrain > 0.0)
       lab_.onSnapshot(
-          [this](const Simulation& s, double eps1) {
-            const lab::GrainKinematics k = lab_.currentKinematics();
-            vtk_.write(s, eps1,
-                       {{{"local_shear_strain", k.localShearStrain}, {"in_band", k.inBand}},
-                        {{"displacement", k.displacement}}});
-          },
+          [this](const Simulation& s, double eps1) { vtk_.write(s, eps1, grainFields()); },
           config.output.vtkEveryStrain);
     if (config.output.checkpointEvery > 0.0)
       lab_.onCheckpoint([this](const lab::Laboratory&) { writeCheckpoint(); }, config.output.checkpointEvery);
   }
 
   lab::Laboratory& lab() { return lab_; }
+  // Per-grain fields of the laboratory's records for the particle snapshots.
+  io::PointFields grainFields() const {
+    const lab::GrainKinematics k = lab_.currentKinematics();
+    const lab::GrainRecords& rec = lab_.grainRecords();
+    std::vector<double> path(rec.rotationPath.size());
+    for (std::size_t i = 0; i < path.size(); ++i) path[i] = radToDeg(rec.rotationPath[i]);
+    return {{{"rotation_deg", k.rotationDeg},
+             {"rotation_path_deg", path},
+             {"sphericity", rec.sphericity},
+             {"local_shear_strain", k.localShearStrain},
+             {"in_band", k.inBand}},
+            {{"displacement", k.displacement}}};
+  }
   json& summary() { return summary_; }
   ProgressLine& progress() { return progress_; }
   io::VtkSeries& vtk() { return vtk_; }
@@ -114,7 +123,7 @@ class RunSession {
   }
 
   // Shears (from the start, or from where a loaded checkpoint left off) and writes every result.
-  int finishTriaxial() {
+  int finishShear() {
     if (!lab_.shearStarted()) {
       lab_.beginShear();
       if (config_.output.checkpointEvery > 0.0) writeCheckpoint();
@@ -122,15 +131,19 @@ class RunSession {
     lab::ShearResult shear = lab_.continueShear();
     progress_.finish();
     const std::vector<lab::Record>& records = shear.records;
+    const bool simpleShear = config_.test.type == "simple-shear";
     lab::TriaxialCurves curves;
     for (const auto& r : records) {
-      curves.eps1.push_back(r.eps1);
+      curves.eps1.push_back(simpleShear ? r.gamma : r.eps1);
       curves.epsV.push_back(r.epsV);
       curves.sigma1.push_back(r.sigma1);
-      curves.sigma3.push_back(0.5 * (r.sigma2 + r.sigma3));
+      // True triaxial: the minor principal stress; otherwise the mean lateral stress.
+      curves.sigma3.push_back(config_.test.type == "true-triaxial" ? r.sigma3 : 0.5 * (r.sigma2 + r.sigma3));
       curves.voidRatio.push_back(r.e);
+      curves.shearStress.push_back(r.tau);
     }
-    const lab::MacroParameters m = lab::computeMacro(curves);
+    const lab::MacroParameters m =
+        simpleShear ? lab::computeSimpleShearMacro(curves) : lab::computeMacro(curves);
     summary_["phi_peak_deg"] = finite(m.phiPeakDeg, "phi_peak_deg");
     summary_["eps1_at_peak"] = m.eps1AtPeak;
     summary_["q_peak"] = m.qPeak;
@@ -138,14 +151,26 @@ class RunSession {
     summary_["residual_window_eps1"] = {m.residualFrom, records.back().eps1};
     summary_["psi_max_deg"] = finite(m.psiMaxDeg, "psi_max_deg");
     summary_["eps1_at_psi_max"] = m.eps1AtPsiMax;
-    summary_["E_MPa"] = finite(m.youngModulus / 1e6, "E_MPa");
-    summary_["E50_MPa"] = finite(m.e50 / 1e6, "E50_MPa");
-    summary_["nu"] = finite(m.poisson, "nu");
+    if (simpleShear) {
+      // Simple shear measures a shear modulus; Young's modulus and Poisson's ratio are not measured.
+      summary_["G_MPa"] = finite(m.shearModulus / 1e6, "G_MPa");
+      summary_["E_MPa"] = nullptr;
+      summary_["E50_MPa"] = nullptr;
+      summary_["nu"] = nullptr;
+      summary_["final_shear_strain"] = records.back().gamma;
+    } else {
+      summary_["E_MPa"] = finite(m.youngModulus / 1e6, "E_MPa");
+      summary_["E50_MPa"] = finite(m.e50 / 1e6, "E50_MPa");
+      summary_["nu"] = finite(m.poisson, "nu");
+    }
     summary_["cs_q_over_p"] = m.csStressRatio;
     summary_["cs_void_ratio"] = m.csVoidRatio;
     summary_["strain_rate"] = shear.strainRate;
     summary_["inertial_number"] = shear.inertialNumber;
     summary_["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
+    if (config_.test.boundary == "walls")
+      summary_["lateral_stress_max_deviation_single_wall"] = shear.maxSingleWallDeviation;
+    summary_["shear_pipeline"] = lab_.shearStageNames();
     if (shear.maxLateralDeviation > 0.02)
       std::fprintf(stderr, "grainlab: warning: lateral stress deviated from sigma3 by up to %.1f %% (> 2 %%)\n",
                    100.0 * shear.maxLateralDeviation);
@@ -170,9 +195,8 @@ class RunSession {
 
   int finishIsotropic() {
     const Simulation& sim = lab_.simulation();
-    if (config_.output.vtkEveryStrain > 0.0) vtk_.write(sim, 0.0);
-    const std::vector<lab::Record> records{lab_.measure(
-        sim.box.length(2), sim.box.volume(), Vec3(sim.box.length(0), sim.box.length(1), sim.box.length(2)), 0.0)};
+    if (config_.output.vtkEveryStrain > 0.0) vtk_.write(sim, 0.0, grainFields());
+    const std::vector<lab::Record> records{lab_.measure()};
     return writeResults(records, summary_.value("preparation_steps", 0L));
   }
 
@@ -192,11 +216,16 @@ class RunSession {
     summary_["wall_seconds"] = wall;
     summary_["particle_steps_per_s"] = static_cast<double>(steps) * config_.sample.nParticles / wall;
     summary_["status"] = "completed";
-    io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records));
+    io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, io::timeseriesColumns(config_)));
     io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
     if (config_.output.plots) makePlots(dir_, quiet_);
     if (!quiet_) {
-      if (summary_.contains("phi_peak_deg"))
+      if (summary_.contains("G_MPa"))
+        std::printf("phi_peak = %.2f deg at gamma = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, G = %.1f MPa\n",
+                    summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
+                    summary_["phi_res_deg"].get<double>(), summary_["psi_max_deg"].get<double>(),
+                    summary_["G_MPa"].get<double>());
+      else if (summary_.contains("phi_peak_deg"))
         std::printf("phi_peak = %.2f deg at eps1 = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, "
                     "E = %.1f MPa, nu = %.3f\n",
                     summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
@@ -220,7 +249,7 @@ class RunSession {
 
 int finish(RunSession& session, const lab::RunConfig& config) {
   try {
-    return config.test.type == "triaxial" ? session.finishTriaxial() : session.finishIsotropic();
+    return config.test.type == "isotropic" ? session.finishIsotropic() : session.finishShear();
   } catch (const SimulationError& e) {
     session.writeFailure(e.what());
     throw;
@@ -267,7 +296,9 @@ int runLab(const RunOptions& opt) {
     // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
     s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
     s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
-    s["prep_friction_deg"] = prep.prepFrictionDeg;
+    // No preparation friction was used for a sample read from a packing file: null, not a number.
+    s["prep_friction_deg"] = prep.prepFrictionDeg ? json(*prep.prepFrictionDeg) : json(nullptr);
+    s["preparation_method"] = config.sample.packing.empty() ? config.sample.method : "packing file";
     json search = json::array();
     for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
     s["prep_search"] = search;
@@ -286,7 +317,7 @@ int runLab(const RunOptions& opt) {
     s["preparation_steps"] = prep.steps;
     if (!opt.quiet)
       std::fprintf(stderr, "prepared: e0 = %.4f (target %.3f, mu_prep = %.2f deg), p = %.1f kPa\n",
-                   prep.e0, config.sample.e0, prep.prepFrictionDeg, (prep.state.wallStress.sum() / 3.0) / 1e3);
+                   prep.e0, config.sample.e0, prep.prepFrictionDeg.value_or(0.0), (prep.state.boundaryStress.sum() / 3.0) / 1e3);
   } catch (const SimulationError& e) {
     session.writeFailure(e.what());
     throw;

@@ -4,189 +4,161 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
+#include "core/contact_driver.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/state_io.hpp"
-#include "geometry/sphere_contacts.hpp"
 
 namespace grainlab {
+
+const std::vector<Simulation::EngineStage>& Simulation::engineStages() {
+  // The engine's pipeline, in order: the one place where the step is defined.
+  static const std::vector<EngineStage> stages{
+      {"broad phase", &Simulation::updateBroadPhase},
+      {"contacts", &Simulation::computeContacts},
+      {"boundary forces", &Simulation::measureBoundary},
+      {"boundary control", &Simulation::controlBoundary},
+      {"integrate", &Simulation::integrate},
+      {"clock", &Simulation::advanceClock},
+  };
+  return stages;
+}
 
 void Simulation::initialise(double skinFraction) {
   double rMin = 1e300;
   for (double r : particles.radius) rMin = std::min(rMin, r);
-  neighbors.skin = skinFraction * rMin;
+  broadPhase.skin = skinFraction * rMin;
   rebuildDue_ = true;
 }
 
 void Simulation::step() {
-  if (rebuildDue_ || neighbors.wallsMoved(box)) {
-    neighbors.build(particles, box);
-    rebuildDue_ = false;
-    slotsStale_ = true;
-  }
-  computeContacts();
-  sumWallForces();
-  updateWalls();
-  integrate();
+  for (const EngineStage& stage : engineStages()) (this->*stage.run)();
+}
+
+void Simulation::advanceClock() {
   ++stepCount;
   time += dt;
 }
 
-void Simulation::computeContacts() {
-  const auto& x = particles.position;
-  const auto& v = particles.velocity;
-  const auto& w = particles.angularVelocity;
-  const auto& rad = particles.radius;
-  const auto& muR = particles.rollingFriction;
-  const std::size_t nPairs = neighbors.pairA.size();
-  pairForce.resize(nPairs);
-  pairTorqueA.resize(nPairs);
-  pairTorqueB.resize(nPairs);
-  const std::size_t nWall = neighbors.wallParticle.size();
-  wallForce.resize(nWall);
-  wallTorque.resize(nWall);
-  // Slip and rolling dissipation, summed per fixed chunk (see parallel.hpp); pairs first, then
-  // wall contacts. Chunks are scheduled dynamically: only touching pairs run the contact law.
-  ChunkedSums pairSums(nPairs, 2), wallSums(nWall, 2);
-  // A pair that was apart and still is keeps its zero slots, so it is skipped without a write;
-  // after a rebuild (pairs renumbered) or a load every slot is written once.
-  const bool writeAll = slotsStale_;
-  slotsStale_ = false;
+void Simulation::updateBroadPhase() {
+  if (boundary == Boundary::Periodic) {
+    if (!rebuildDue_) return;
+    wrapIntoCell();
+    broadPhase.buildPeriodic(particles, cell, contacts);
+  } else {
+    if (!rebuildDue_ && !broadPhase.wallsMoved(box)) return;
+    broadPhase.buildWalls(particles, box, contacts);
+  }
+  rebuildDue_ = false;
+}
 
+void Simulation::wrapIntoCell() {
+  // Particles that left the cell re-enter through the opposite face: x <- x - H w with w the whole
+  // periods crossed. Their contacts keep their history; only the image shifts change.
+  const std::size_t n = particles.size();
+  std::vector<std::array<int, 3>> wrap(n, {0, 0, 0});
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 s = cell.hInverse * particles.position[i];
+    for (int a = 0; a < 3; ++a) {
+      const double f = std::floor(s[a]);
+      if (f != 0.0) {
+        if (!ImageShift::packable(static_cast<int>(f)))
+          throw SimulationError(fmt::format("particle {} left the periodic cell by {} periods (step {}); "
+                                            "reduce solver.dt_factor or the loading rate",
+                                            particles.id[i], f, stepCount));
+        wrap[i][a] = static_cast<int>(f);
+        any = true;
+      }
+    }
+    if (wrap[i] != std::array<int, 3>{0, 0, 0}) {
+      particles.position[i] -= cell.h * Vec3(wrap[i][0], wrap[i][1], wrap[i][2]);
+      for (int a = 0; a < 3; ++a) particles.image[i][a] += wrap[i][a];
+    }
+  }
+  if (any) contacts.sphereSphere.applyWrap(wrap);
+}
+
+template <bool Periodic>
+void Simulation::computeContactsFor() {
+  const ContactContext ctx{particles, model, box, cell, dt};
+  auto& pairs = contacts.sphereSphere;
+  auto& walls = contacts.sphereWall;
+  ChunkedSums pairSums(pairs.size(), Periodic ? kContactSums : 2), wallSums(walls.size(), 2);
+  const bool writeAllPairs = pairs.slotsStale, writeAllWalls = walls.slotsStale;
+  pairs.slotsStale = false;
+  walls.slotsStale = false;
 #pragma omp parallel
   {
-#pragma omp for schedule(dynamic, 1) nowait
-  for (std::size_t chunk = 0; chunk < pairSums.chunks(); ++chunk) {
-  double slip = 0.0, roll = 0.0;
-  for (std::size_t p = pairSums.begin(chunk); p < pairSums.end(chunk); ++p) {
-    const std::uint32_t a = neighbors.pairA[p], b = neighbors.pairB[p];
-    contact::ContactHistory& h = neighbors.pairHistory[p];
-    const Vec3 branch = x[b] - x[a];
-    const double dist2 = branch.squaredNorm();
-    const double reach = rad[a] + rad[b];
-    if (dist2 >= reach * reach) {
-      if (!h.touching && !writeAll) continue;
-      h = contact::ContactHistory{};
-      pairForce[p].setZero();
-      pairTorqueA[p].setZero();
-      pairTorqueB[p].setZero();
-      continue;
-    }
-    const geometry::ContactGeometry g = geometry::sphereSphere(branch, dist2, rad[a], rad[b]);
-    if (!h.touching) {
-      h.touching = true;
-      h.prevNormal = g.normal;
-    }
-    contact::ContactKinematics k;
-    k.normal = g.normal;
-    k.prevNormal = h.prevNormal;
-    k.overlap = g.overlap;
-    k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
-    k.relativeSpin = w[b] - w[a];
-    k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
-    k.dt = dt;
-    const contact::ContactResponse res =
-        contact::applyLaw(model.pairParams(rad[a], rad[b], muR[a], muR[b]), k, h);
-    pairForce[p] = res.force;
-    pairTorqueA[p] = g.branchA.cross(-res.force) + res.moment;
-    pairTorqueB[p] = g.branchB.cross(res.force) - res.moment;
-    slip += res.slipDissipation;
-    roll += res.rollDissipation;
+    evaluateContacts<SphereSphere, Periodic>(pairs, ctx, pairSums, writeAllPairs);
+    if constexpr (!Periodic) evaluateContacts<SpherePlane, false>(walls, ctx, wallSums, writeAllWalls);
   }
-  pairSums.at(chunk, 0) = slip;
-  pairSums.at(chunk, 1) = roll;
+  energy.slip += pairSums.total(kSlip) + wallSums.total(kSlip);
+  energy.rolling += pairSums.total(kRoll) + wallSums.total(kRoll);
+  if constexpr (Periodic) {
+    const double v = cell.volume();
+    for (int i = 0; i < 9; ++i) cell.stress(i % 3, i / 3) = pairSums.total(kStress0 + i) / v;
+    for (int i = 0; i < 3; ++i) cell.stiffness[i] = pairSums.total(kStiffness0 + i) / v;
+    for (int i = 0; i < 3; ++i) cell.shearStiffness[i] = pairSums.total(kShearStiffness0 + i) / v;
   }
+}
 
-#pragma omp for schedule(dynamic, 1)
-  for (std::size_t chunk = 0; chunk < wallSums.chunks(); ++chunk) {
-  double slip = 0.0, roll = 0.0;
-  for (std::size_t c = wallSums.begin(chunk); c < wallSums.end(chunk); ++c) {
-    const std::uint32_t i = neighbors.wallParticle[c];
-    const Wall& wall = box.walls[neighbors.wallIndex[c]];
-    contact::ContactHistory& h = neighbors.wallHistory[c];
-    const Vec3 n = wall.inwardNormal();
-    Vec3 planePoint = x[i];
-    planePoint[wall.axis] = wall.position;
-    const geometry::ContactGeometry g = geometry::spherePlane(x[i], rad[i], planePoint, n);
-    if (g.overlap <= 0.0) {
-      if (!h.touching && !writeAll) continue;
-      h = contact::ContactHistory{};
-      wallForce[c].setZero();
-      wallTorque[c].setZero();
-      continue;
-    }
-    if (!h.touching) {
-      h.touching = true;
-      h.prevNormal = n;
-    }
-    Vec3 wallVelocity = Vec3::Zero();
-    wallVelocity[wall.axis] = wall.velocity;
-    contact::ContactKinematics k;
-    k.normal = n;
-    k.prevNormal = h.prevNormal;
-    k.overlap = g.overlap;
-    k.relativeVelocity = v[i] + w[i].cross(g.branchB) - wallVelocity;
-    k.relativeSpin = w[i];
-    k.meanSpinNormal = 0.5 * w[i].dot(n);
-    k.dt = dt;
-    const contact::ContactResponse res =
-        contact::applyLaw(model.wallParams(rad[i], wall.tanFriction, muR[i]), k, h);
-    wallForce[c] = res.force;
-    wallTorque[c] = g.branchB.cross(res.force) - res.moment;
-    slip += res.slipDissipation;
-    roll += res.rollDissipation;
-  }
-  wallSums.at(chunk, 0) = slip;
-  wallSums.at(chunk, 1) = roll;
-  }
-  }
-  energy.slip += pairSums.total(0) + wallSums.total(0);
-  energy.rolling += pairSums.total(1) + wallSums.total(1);
+void Simulation::computeContacts() {
+  if (boundary == Boundary::Periodic) computeContactsFor<true>();
+  else computeContactsFor<false>();
 }
 
 void Simulation::gatherParticle(std::size_t i) {
-  // Each particle sums its own contacts in a fixed order: no races, and the sums do not depend on
-  // the number of threads (bit-identical results for any thread count).
+  // Each particle sums its own contacts, kind by kind, in a fixed order: no races, and the sums do
+  // not depend on the number of threads (bit-identical results for any thread count).
   Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-  for (std::uint32_t s = neighbors.incidentStart[i]; s < neighbors.incidentStart[i + 1]; ++s) {
-    const std::uint32_t e = neighbors.incident[s];
-    const std::uint32_t p = e >> 1;
-    if (e & 1u) {
-      fi += pairForce[p];
-      ti += pairTorqueB[p];
-    } else {
-      fi -= pairForce[p];
-      ti += pairTorqueA[p];
+  contacts.forEach([&](const auto& list) {
+    using Kind = typename std::decay_t<decltype(list)>::KindType;
+    for (std::uint32_t s = list.incidentStart[i]; s < list.incidentStart[i + 1]; ++s) {
+      const std::uint32_t e = list.incident[s];
+      const std::uint32_t c = e >> 1;
+      if constexpr (Kind::kPlane) {  // the force of the wall on the particle
+        fi += list.force[c];
+        ti += list.torqueA[c];
+      } else if (e & 1u) {  // the particle is body B: the force of A on it
+        fi += list.force[c];
+        ti += list.torqueB[c];
+      } else {
+        fi -= list.force[c];
+        ti += list.torqueA[c];
+      }
     }
-  }
-  for (std::uint32_t c = neighbors.wallStart[i]; c < neighbors.wallStart[i + 1]; ++c) {
-    fi += wallForce[c];
-    ti += wallTorque[c];
-  }
+  });
   particles.force[i] = fi;
   particles.torque[i] = ti;
 }
 
-void Simulation::sumWallForces() {
-  // The particles' own sums are done in integrate() (one pass over the particles instead of two,
-  // one parallel region less per step); here only the walls' forces, which the servos need first.
+void Simulation::measureBoundary() {
+  if (boundary == Boundary::Periodic) return;  // the cell's stress is summed by the contact stage
+  // The walls' forces, which their servos need.
   for (Wall& wall : box.walls) {
     wall.normalForce = 0.0;
     wall.contactStiffness = 0.0;
     wall.contacts = 0;
   }
-  for (std::size_t c = 0; c < neighbors.wallParticle.size(); ++c) {
-    if (!neighbors.wallHistory[c].touching) continue;
-    Wall& wall = box.walls[neighbors.wallIndex[c]];
-    wall.normalForce += wallForce[c].dot(wall.inwardNormal());
-    wall.contactStiffness += model.wallParams(particles.radius[neighbors.wallParticle[c]],
-                                              wall.tanFriction).kn;
+  const auto& list = contacts.sphereWall;
+  for (std::size_t c = 0; c < list.size(); ++c) {
+    if (!list.history[c].touching) continue;
+    Wall& wall = box.walls[list.b[c]];
+    wall.normalForce += list.force[c].dot(wall.inwardNormal());
+    wall.contactStiffness += model.wallParams(particles.radius[list.a[c]], wall.tanFriction).kn;
     ++wall.contacts;
   }
 }
 
-void Simulation::updateWalls() {
+void Simulation::controlBoundary() {
+  if (boundary == Boundary::Periodic) controlCell();
+  else controlWalls();
+}
+
+void Simulation::controlWalls() {
   for (Wall& wall : box.walls) {
     if (wall.control != WallControl::Stress) continue;
     const double sigma = wall.normalForce / box.area(wall.axis);
@@ -212,16 +184,82 @@ void Simulation::updateWalls() {
   }
 }
 
+void Simulation::controlCell() {
+  // L from the servo and the imposed rates, or as the caller prescribed it.
+  Mat3& L = cell.velocityGradient;
+  if (!cell.prescribedGradient) setCellGradient();
+  // Work done on the particles by the cell: -V sigma:L dt with sigma the Love–Weber stress
+  // (compression positive), the rate at which the imposed deformation loads the contacts.
+  energy.boundaryWork -= cell.volume() * cell.stress.cwiseProduct(L).sum() * dt;
+  cell.advance(dt);
+}
+
+void Simulation::setCellGradient() {
+  // The cell's stress servo (PHYSICS.md §5.2), the strain-space twin of the wall servo
+  // (servo_settings.hpp): the stress error over the assembly's affine stiffness K is the
+  // compressive strain u that would cancel it if every contact deformed with the mean strain; the
+  // cell strains by gain u per step plus an integral term that learns the rate a dilating or
+  // contracting sample needs. The affine stiffness overestimates the real one (grains rearrange), so
+  // the loop undershoots rather than oscillates, whatever Ec and p. Rates are capped so that a face
+  // never closes faster than two walls would (2 servo.maxSpeed).
+  auto servoRate = [&](double error, double stiffness, double& integral, double maxRate) {
+    double rate = 0.0;  // compressive (true) strain rate [1/s]
+    if (stiffness > 0.0) {
+      const double u = error / stiffness;
+      if (servo.integralSteps > 0.0)
+        integral = std::clamp(integral + servo.gain * u / (servo.integralSteps * dt), -maxRate, maxRate);
+      rate = servo.gain * u / dt + integral;
+    } else {
+      integral = 0.0;
+      rate = error > 0.0 ? maxRate : 0.0;  // no contact yet: close at the cap
+    }
+    return std::clamp(rate, -maxRate, maxRate);
+  };
+  Mat3& L = cell.velocityGradient;
+  L.setZero();
+  const Vec3 lengths = cell.h.diagonal();
+  for (int k = 0; k < 3; ++k) {
+    const double maxRate = 2.0 * servo.maxSpeed / lengths[k];
+    const double rate = cell.control[k] == CellControl::StrainRate
+                            ? cell.strainRate[k] * cell.referenceLength[k] / lengths[k]  // engineering rate on H0
+                            : servoRate(cell.targetStress[k] - cell.stress(k, k), cell.stiffness[k],
+                                        cell.servoIntegral[k], maxRate);
+    L(k, k) = -rate;
+  }
+  const Vec3 shear = cell.shearStress();
+  for (int k = 0; k < 3; ++k) {
+    if (cell.shearControl[k] != CellControl::Stress) continue;
+    const int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+    const double maxRate = 2.0 * servo.maxSpeed / std::max(lengths[i], lengths[j]);
+    // Pure shear (no spin): L_ij = L_ji = -rate raises the symmetrised sigma_ij by K_ij rate dt.
+    const double rate = servoRate(cell.targetShearStress[k] - shear[k], cell.shearStiffness[k],
+                                  cell.shearServoIntegral[k], maxRate);
+    L(i, j) = L(j, i) = -rate;
+  }
+  L(0, 2) += cell.shearRate;
+}
+
 void Simulation::integrate() {
+  if (boundary == Boundary::Periodic) integrateFor<true>();
+  else integrateFor<false>();
+}
+
+template <bool Periodic>
+void Simulation::integrateFor() {
   const std::size_t n = particles.size();
   auto& x = particles.position;
   auto& v = particles.velocity;
   auto& q = particles.orientation;
   auto& w = particles.angularVelocity;
-  const auto& xBuild = neighbors.positionsAtBuild();
+  const auto& xBuild = broadPhase.positionsAtBuild();
   const double alpha = localDamping;
   const double h = dt;
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
+  // Periodic cell: particles move with the homogeneous flow too, x <- x + v h + M x, the same map
+  // M = exp(L h) - I that advanced H; the rebuild test measures displacements from where that flow
+  // has carried each particle's build position (F x_build, F = H H_build^-1).
+  const Mat3 flowStep = cell.flowStep(h);
+  const Mat3 deformation = Periodic ? broadPhase.cellDeformation(cell) : Mat3::Identity();
   double maxDisp2 = 0.0;
   long badParticle = -1;
   ChunkedSums dampingWork(n, 1);
@@ -244,7 +282,8 @@ void Simulation::integrate() {
     w[i] += (t + td) * (h * particles.invInertia[i]);
     // Work of the damping forces over the step, with the mean of old and new velocities.
     work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
-    x[i] += v[i] * h;
+    if constexpr (Periodic) x[i] += v[i] * h + flowStep * x[i];
+    else x[i] += v[i] * h;
     const double wNorm = w[i].norm();
     if (wNorm > 0.0) {
       // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
@@ -255,12 +294,17 @@ void Simulation::integrate() {
       const double eps = qn.coeffs().squaredNorm() - 1.0;
       qn.coeffs() *= std::abs(eps) < 1e-6 ? 1.0 - 0.5 * eps + 0.375 * eps * eps : 1.0 / std::sqrt(1.0 + eps);
       q[i] = qn;
-      particles.rotationPath[i] += wNorm * h;
     }
-    if (!xBuild.empty()) maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
+    if (!xBuild.empty()) {
+      if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
+      else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
+    }
     const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
-    const double r = particles.radius[i];
-    const bool inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
+    bool inside = true;
+    if constexpr (!Periodic) {
+      const double r = particles.radius[i];
+      inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
+    }
     if (!finite || !inside) {
 #pragma omp critical
       if (badParticle < 0 || static_cast<long>(i) < badParticle) badParticle = static_cast<long>(i);
@@ -275,18 +319,50 @@ void Simulation::integrate() {
     throw SimulationError(fmt::format(
         "numerical instability at step {}: particle {} {} (position {:.6g} {:.6g} {:.6g}, "
         "velocity {:.6g} {:.6g} {:.6g}); reduce solver.dt_factor or the loading rate",
-        stepCount + 1, i, finite ? "left the box" : "has a non-finite state", x[i][0], x[i][1],
+        stepCount + 1, particles.id[i], finite ? "left the box" : "has a non-finite state", x[i][0], x[i][1],
         x[i][2], v[i][0], v[i][1], v[i][2]));
   }
-  const double halfSkin = neighbors.halfSkin();
-  if (maxDisp2 > halfSkin * halfSkin) rebuildDue_ = true;
+  const double halfSkin = broadPhase.halfSkin();
+  if constexpr (Periodic) {
+    // The homogeneous deformation since the build changes a distance b by at most |F^T F - I| b (a
+    // rotation changes none); for the pairs that matter, b <= reach + skin, and together with the
+    // fluctuations that change must stay within the skin.
+    const double affine = (deformation.transpose() * deformation - Mat3::Identity()).norm() *
+                          (broadPhase.reach(particles) + broadPhase.skin);
+    if (2.0 * std::sqrt(maxDisp2) + affine > broadPhase.skin) rebuildDue_ = true;
+  } else {
+    if (maxDisp2 > halfSkin * halfSkin) rebuildDue_ = true;
+  }
+}
+
+std::size_t Simulation::touchingPairs() const {
+  std::size_t count = 0;
+  for (const auto& h : contacts.sphereSphere.history) count += h.touching;
+  return count;
+}
+
+void Simulation::reorder(const std::vector<std::uint32_t>& order) {
+  const std::size_t n = particles.size();
+  if (order.size() != n) throw std::invalid_argument("reorder: the order must list every particle once");
+  std::vector<std::uint32_t> newIndex(n, ~0u);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (order[k] >= n || newIndex[order[k]] != ~0u)
+      throw std::invalid_argument("reorder: the order must list every particle once");
+    newIndex[order[k]] = static_cast<std::uint32_t>(k);
+  }
+  particles.permute(order);
+  contacts.forEach([&](auto& list) { list.renumber(newIndex, n); });
+  broadPhase.permute(order);
 }
 
 void Simulation::saveState(std::ostream& out) const {
   using namespace stateio;
   particles.saveState(out);
+  put(out, boundary);
   put(out, box);
-  neighbors.saveState(out);
+  put(out, cell);
+  broadPhase.saveState(out);
+  contacts.forEach([&](const auto& list) { list.saveState(out); });
   put(out, model);
   put(out, servo);
   put(out, energy);
@@ -295,19 +371,17 @@ void Simulation::saveState(std::ostream& out) const {
   put(out, localDamping);
   put(out, stepCount);
   put(out, time);
-  putVector(out, pairForce);
-  putVector(out, pairTorqueA);
-  putVector(out, pairTorqueB);
-  putVector(out, wallForce);
-  putVector(out, wallTorque);
   put(out, rebuildDue_);
 }
 
 void Simulation::loadState(std::istream& in) {
   using namespace stateio;
   particles.loadState(in);
+  get(in, boundary);
   get(in, box);
-  neighbors.loadState(in);
+  get(in, cell);
+  broadPhase.loadState(in);
+  contacts.forEach([&](auto& list) { list.loadState(in, particles.size()); });
   get(in, model);
   get(in, servo);
   get(in, energy);
@@ -316,19 +390,7 @@ void Simulation::loadState(std::istream& in) {
   get(in, localDamping);
   get(in, stepCount);
   get(in, time);
-  getVector(in, pairForce);
-  getVector(in, pairTorqueA);
-  getVector(in, pairTorqueB);
-  getVector(in, wallForce);
-  getVector(in, wallTorque);
   get(in, rebuildDue_);
-  slotsStale_ = true;
-}
-
-std::size_t Simulation::touchingPairs() const {
-  std::size_t count = 0;
-  for (const auto& h : neighbors.pairHistory) count += h.touching;
-  return count;
 }
 
 }  // namespace grainlab

@@ -1,17 +1,22 @@
 #pragma once
-// The DEM engine for spheres in a box of rigid walls. One call of step() runs the pipeline
+// The DEM engine: particles of any supported shape in a box of rigid walls or in a periodic cell.
+// One call of step() runs the engine stages, listed in one place (engineStages()):
 //
-//   broad phase (Verlet list, rebuilt when due) -> narrow phase + contact law (per pair, parallel)
-//   -> wall forces & servos -> per particle: force gather (fixed order) + integrator (leapfrog +
-//   damping), fused in one parallel pass
+//   broad phase (Verlet list, rebuilt when due) -> contacts (one driver instantiated per pair kind)
+//   -> boundary forces (wall sums / cell stress) -> boundary control (wall servos / cell servo)
+//   -> integrate (per particle: force gather in fixed order + damping + leapfrog) -> clock
 //
-// Laboratory protocols drive it from outside (recorders and stop checks between steps).
+// Laboratory protocols run the same stages inside a Pipeline (core/pipeline.hpp) with their own
+// drives, recorders and stop conditions around them.
+#include <iosfwd>
 #include <string>
 #include <vector>
 
 #include "contact/models.hpp"
-#include "core/neighbor_list.hpp"
+#include "core/broad_phase.hpp"
+#include "core/contact_list.hpp"
 #include "core/particles.hpp"
+#include "core/periodic_cell.hpp"
 #include "core/servo_settings.hpp"
 #include "core/walls.hpp"
 
@@ -22,14 +27,19 @@ struct EnergyLedger {
   double slip = 0.0;
   double rolling = 0.0;
   double damping = 0.0;
-  double boundaryWork = 0.0;  // work done on the particles by the walls
+  double boundaryWork = 0.0;  // work done on the particles by the walls or the deforming cell
 };
+
+enum class Boundary : std::uint8_t { Walls = 0, Periodic = 1 };
 
 class Simulation {
  public:
   Particles particles;
-  WallBox box;
-  NeighborList neighbors;
+  Boundary boundary = Boundary::Walls;
+  WallBox box;         // Boundary::Walls
+  PeriodicCell cell;   // Boundary::Periodic
+  ContactStore contacts;
+  BroadPhase broadPhase;
   contact::SphereContactModel model;
   ServoSettings servo;
   EnergyLedger energy;
@@ -40,35 +50,54 @@ class Simulation {
   long stepCount = 0;
   double time = 0.0;          // [s]
 
-  // Per-contact results of the latest step (parallel to neighbors' arrays).
-  std::vector<Vec3> pairForce;    // force of A on B [N]
-  std::vector<Vec3> pairTorqueA;  // total torque on A from this contact [N m]
-  std::vector<Vec3> pairTorqueB;
-  std::vector<Vec3> wallForce;    // force of the wall on the particle [N]
-  std::vector<Vec3> wallTorque;
-
-  // Sets the neighbour skin from the particle sizes; call after adding particles.
+  // Sets the neighbour skin from the particle sizes; call after adding particles or changing the
+  // boundary.
   void initialise(double skinFraction = 0.2);
   // Critical time step (PHYSICS.md §4): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
   // the stiffest contact the particle can have (against a wall).
   double criticalTimeStep() const;
+  // One step: every engine stage in order.
   void step();
 
-  // Number of touching particle-particle contacts at the latest step.
+  // The engine stages, in the order step() runs them.
+  struct EngineStage {
+    const char* name;
+    void (Simulation::*run)();
+  };
+  static const std::vector<EngineStage>& engineStages();
+
+  // Volume enclosed by the boundary [m^3].
+  double volume() const { return boundary == Boundary::Periodic ? cell.volume() : box.volume(); }
+  // Number of touching particle–particle contacts at the latest step.
   std::size_t touchingPairs() const;
+  // Moves particle order[k] to storage index k (ids stay with their particles); contacts, their
+  // history and the broad phase follow.
+  void reorder(const std::vector<std::uint32_t>& order);
 
   // Exact binary state for checkpoints: a loaded simulation continues bit for bit.
   void saveState(std::ostream& out) const;
   void loadState(std::istream& in);
+  // Checks a loaded state before it is used: sizes consistent, indices in range, finite numbers.
+  // Throws std::runtime_error naming what is wrong.
+  void validateState() const;
 
  private:
+  void updateBroadPhase();
   void computeContacts();
-  void sumWallForces();
-  void gatherParticle(std::size_t i);
-  void updateWalls();
+  void measureBoundary();
+  void controlBoundary();
   void integrate();
+  void advanceClock();
+  void gatherParticle(std::size_t i);
+  template <bool Periodic>
+  void computeContactsFor();
+  template <bool Periodic>
+  void integrateFor();
+  void controlWalls();
+  void controlCell();
+  void setCellGradient();
+  void wrapIntoCell();
   bool rebuildDue_ = true;
-  bool slotsStale_ = true;  // pair/wall force slots not yet written since the last rebuild or load
 };
 
 }  // namespace grainlab

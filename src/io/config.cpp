@@ -269,6 +269,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
   c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
+  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth"});
+  c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
+                                 "must be in (0, 0.01] (relative radius growth per step)");
   s.finish();
 
   Section ct(root, "contact");
@@ -320,8 +323,10 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   ct.finish();
 
   Section t(root, "test");
-  c.test.type = t.string("type", c.test.type, {"isotropic", "triaxial"});
-  c.test.boundary = t.string("boundary", c.test.boundary, {"walls"});
+  c.test.type = t.string("type", c.test.type, {"isotropic", "triaxial", "constant-p", "true-triaxial", "simple-shear"});
+  c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
+  if (c.test.type == "simple-shear" && c.test.boundary != "periodic")
+    fail("test.type", "\"simple-shear\"", "needs test.boundary = \"periodic\" (a wall box has no shearing walls)");
   c.test.confiningPressure = t.number("confining_pressure", c.test.confiningPressure, 0.0, 1e10, true, false, "must be > 0 [Pa]");
   if (const toml::node* n = t.raw("axial_strain_rate")) {
     if (n->is_string() && n->value<std::string>().value() == "auto") {
@@ -332,6 +337,16 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     }
   }
   c.test.finalAxialStrain = t.number("final_axial_strain", c.test.finalAxialStrain, 0.0, 0.5, true, false, "must be in (0, 0.5]");
+  c.test.b = t.number("b", c.test.b, 0.0, 1.0, false, false, "must be in [0, 1] ((sigma2 - sigma3)/(sigma1 - sigma3))");
+  if (const toml::node* n = t.raw("shear_strain_rate")) {
+    if (n->is_string() && n->value<std::string>().value() == "auto") {
+      c.test.shearStrainRate.reset();
+    } else {
+      c.test.shearStrainRate = t.number("shear_strain_rate", 0.0, 0.0, 1e3, true, false,
+                                        "must be \"auto\" or a rate > 0 [1/s]");
+    }
+  }
+  c.test.finalShearStrain = t.number("final_shear_strain", c.test.finalShearStrain, 0.0, 2.0, true, false, "must be in (0, 2]");
   t.finish();
 
   Section so(root, "solver");
@@ -394,6 +409,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
       {"prep_damping", c.sample.prepDamping},
       {"packing", c.sample.packing},
       {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
+      {"method", c.sample.method},
+      {"growth_rate", c.sample.growthRate},
   };
   if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
   else sample.insert("prep_friction_deg", "auto");
@@ -412,9 +429,13 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   toml::table test{{"type", c.test.type},
                    {"boundary", c.test.boundary},
                    {"confining_pressure", c.test.confiningPressure},
-                   {"final_axial_strain", c.test.finalAxialStrain}};
+                   {"final_axial_strain", c.test.finalAxialStrain},
+                   {"b", c.test.b},
+                   {"final_shear_strain", c.test.finalShearStrain}};
   if (c.test.axialStrainRate) test.insert("axial_strain_rate", *c.test.axialStrainRate);
   else test.insert("axial_strain_rate", "auto");
+  if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);
+  else test.insert("shear_strain_rate", "auto");
   toml::table solver{{"damping", c.solver.damping},
                      {"dt_factor", c.solver.dtFactor},
                      {"force_dt", c.solver.forceDt},

@@ -52,6 +52,7 @@ void loadPacking(const std::filesystem::path& file, double density, Simulation& 
   }
   if (particles.size() < 2) throw bad(lineNo, "fewer than two spheres");
   sim.particles = std::move(particles);
+  sim.boundary = Boundary::Walls;
   sim.box.setBounds(Vec3(walls[0], walls[2], walls[4]), Vec3(walls[1], walls[3], walls[5]));
 }
 

@@ -24,11 +24,24 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
   std::filesystem::rename(tmp, path);
 }
 
-std::string timeseriesCsv(const std::vector<lab::Record>& records) {
+TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
+  return {config.test.boundary == "periodic", config.test.type == "simple-shear", config.test.type == "true-triaxial"};
+}
+
+std::string timeseriesCsv(const std::vector<lab::Record>& records, const TimeseriesColumns& columns) {
   std::string s =
       "step,time,eps1,eps_v,sigma1,sigma2,sigma3,q,p,e,phi_deg,Z,unbalanced,eps2,eps3,"
       "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
-      "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction\n";
+      "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction";
+  if (columns.periodic) s += ",eps1_log,stress_skew";
+  if (columns.simpleShear) s += ",gamma,tau";
+  if (columns.trueTriaxial) s += ",b";
+  s += '\n';
+  auto put = [&](long step, double v) {
+    if (!std::isfinite(v))
+      throw SimulationError(fmt::format("non-finite value in the time series at step {}", step));
+    s += fmt::format(",{:.10g}", v);
+  };
   for (const auto& r : records) {
     const double values[] = {r.time, r.eps1, r.epsV, r.sigma1, r.sigma2, r.sigma3, r.q, r.p, r.e,
                              r.phiDeg, r.coordination, r.unbalanced, r.eps2, r.eps3,
@@ -37,10 +50,18 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records) {
                              r.dissipDamping, r.rotationMeanDeg, r.rotationBandMeanDeg,
                              r.bandFraction};
     s += fmt::format("{}", r.step);
-    for (double v : values) {
-      if (!std::isfinite(v))
-        throw SimulationError(fmt::format("non-finite value in the time series at step {}", r.step));
-      s += fmt::format(",{:.10g}", v);
+    for (double v : values) put(r.step, v);
+    if (columns.periodic) {
+      put(r.step, r.eps1Log);
+      put(r.step, r.stressSkew);
+    }
+    if (columns.simpleShear) {
+      put(r.step, r.gamma);
+      put(r.step, r.tau);
+    }
+    if (columns.trueTriaxial) {
+      if (std::isnan(r.b)) s += ",";
+      else put(r.step, r.b);
     }
     s += '\n';
   }

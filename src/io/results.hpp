@@ -10,8 +10,16 @@ namespace grainlab::io {
 
 void writeFileAtomic(const std::filesystem::path& path, const std::string& content);
 
+// Columns beyond the common ones that a test writes: the periodic cell's (eps1_log,
+// stress_skew), simple shear's (gamma, tau) and true triaxial's (b).
+struct TimeseriesColumns {
+  bool periodic = false, simpleShear = false, trueTriaxial = false;
+};
+TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
+
 // The time series as CSV (header + one row per record). Throws SimulationError on a non-finite
-// value rather than writing it.
-std::string timeseriesCsv(const std::vector<lab::Record>& records);
+// value rather than writing it; only b, undefined while sigma1 = sigma3, is written as an empty
+// field (null) there.
+std::string timeseriesCsv(const std::vector<lab::Record>& records, const TimeseriesColumns& columns = {});
 
 }  // namespace grainlab::io

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "io/results.hpp"
+#include "core/contact_view.hpp"
 #include "lab/measurements.hpp"
 
 namespace grainlab::io {
@@ -69,7 +70,7 @@ class VtuPiece {
   std::string pointData_, cellData_;
 };
 
-constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9;
+constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9, kHexahedron = 12;
 
 std::string pvd(const std::string& kind, const std::vector<double>& labels) {
   std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
@@ -84,44 +85,44 @@ std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   const Particles& P = sim.particles;
   const std::size_t n = P.size();
   const std::vector<int> counts = lab::contactsPerParticle(sim);
-  std::vector<double> contacts(counts.begin(), counts.end()), angle(n), path(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    angle[i] = radToDeg(P.rotationAngle(i));
-    path[i] = radToDeg(P.rotationPath[i]);
-  }
+  std::vector<double> contacts(counts.begin(), counts.end()), ids(n);
+  for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<double>(P.id[i]);
   VtuPiece v;
   v.points(P.position);
   for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, kVertex);
+  v.pointScalar("id", ids);
   v.pointScalar("radius", P.radius);
   v.pointVector("velocity", P.velocity);
   v.pointVector("angular_velocity", P.angularVelocity);
-  v.pointScalar("rotation_deg", angle);
-  v.pointScalar("rotation_path_deg", path);
   v.pointScalar("contacts", contacts);
   v.pointScalar("mu_r", P.rollingFriction);
-  v.pointScalar("sphericity", P.sphericity);
   for (const auto& [name, values] : extra.scalars) v.pointScalar(name, values);
   for (const auto& [name, values] : extra.vectors) v.pointVector(name, values);
   return v.text();
 }
 
 std::string contactsVtu(const Simulation& sim) {
-  const auto& nl = sim.neighbors;
+  // Lines between the centres; a contact across a face of a periodic cell is drawn to the image of
+  // its second body (an extra point), not across the cell.
+  std::vector<Vec3> points = sim.particles.position;
   VtuPiece v;
-  v.points(sim.particles.position);
   std::vector<double> fn, ft;
   std::vector<Vec3> force, normal;
-  for (std::size_t p = 0; p < nl.pairA.size(); ++p) {
-    if (!nl.pairHistory[p].touching) continue;
-    const std::uint32_t a = nl.pairA[p], b = nl.pairB[p];
-    const Vec3 n = (sim.particles.position[b] - sim.particles.position[a]).normalized();
-    const Vec3& f = sim.pairForce[p];
-    v.cell({a, b}, kLine);
-    fn.push_back(f.dot(n));
-    ft.push_back((f - f.dot(n) * n).norm());
-    force.push_back(f);
-    normal.push_back(n);
-  }
+  forEachTouchingContact(sim, [&](const ContactView& c) {
+    if (c.wall) return;
+    std::int64_t end = c.b;
+    const Vec3 image = sim.particles.position[c.a] + c.branch;
+    if ((image - sim.particles.position[c.b]).squaredNorm() > 1e-24 * c.branch.squaredNorm()) {
+      end = static_cast<std::int64_t>(points.size());
+      points.push_back(image);
+    }
+    v.cell({c.a, end}, kLine);
+    fn.push_back(c.force.dot(c.normal));
+    ft.push_back((c.force - c.force.dot(c.normal) * c.normal).norm());
+    force.push_back(c.force);
+    normal.push_back(c.normal);
+  });
+  v.points(points);
   v.cellScalar("normal_force", fn);
   v.cellScalar("tangential_force", ft);
   v.cellVector("force", force);
@@ -130,6 +131,7 @@ std::string contactsVtu(const Simulation& sim) {
 }
 
 std::string wallsVtu(const Simulation& sim) {
+  if (sim.boundary == Boundary::Periodic) return cellVtu(sim);
   const WallBox& box = sim.box;
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   std::vector<Vec3> corners;
@@ -156,13 +158,31 @@ std::string wallsVtu(const Simulation& sim) {
   return v.text();
 }
 
+std::string cellVtu(const Simulation& sim) {
+  // The periodic cell as one hexahedron with corners H (i, j, k), i, j, k in {0, 1}, in VTK's
+  // corner order, and its stress as cell data.
+  const Mat3& h = sim.cell.h;
+  static constexpr int kOrder[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                       {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  std::vector<Vec3> corners;
+  for (const auto& c : kOrder) corners.push_back(h * Vec3(c[0], c[1], c[2]));
+  VtuPiece v;
+  v.points(corners);
+  v.cell({0, 1, 2, 3, 4, 5, 6, 7}, kHexahedron);
+  const Mat3& s = sim.cell.stress;
+  v.cellVector("stress_diagonal", {Vec3(s(0, 0), s(1, 1), s(2, 2))});
+  v.cellVector("stress_shear_yz_xz_xy", {Vec3(0.5 * (s(1, 2) + s(2, 1)), 0.5 * (s(0, 2) + s(2, 0)), 0.5 * (s(0, 1) + s(1, 0)))});
+  return v.text();
+}
+
 void VtkSeries::write(const Simulation& sim, double label, const PointFields& extra) {
   const std::size_t index = labels_.size();
   writeFileAtomic(dir_ / fmt::format("particles_{:04d}.vtu", index), particlesVtu(sim, extra));
   writeFileAtomic(dir_ / fmt::format("contacts_{:04d}.vtu", index), contactsVtu(sim));
-  writeFileAtomic(dir_ / fmt::format("walls_{:04d}.vtu", index), wallsVtu(sim));
+  const char* boundary = sim.boundary == Boundary::Periodic ? "cell" : "walls";
+  writeFileAtomic(dir_ / fmt::format("{}_{:04d}.vtu", boundary, index), wallsVtu(sim));
   labels_.push_back(label);
-  for (const char* kind : {"particles", "contacts", "walls"})
+  for (const char* kind : {"particles", "contacts", boundary})
     writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvd(kind, labels_));
 }
 

@@ -20,7 +20,8 @@ class VtkSeries {
   // `labels`: the snapshots an interrupted run already wrote (resume continues the numbering).
   explicit VtkSeries(std::filesystem::path dir, std::vector<double> labels = {})
       : dir_(std::move(dir)), labels_(std::move(labels)) {}
-  // Writes particles_NNNN.vtu, contacts_NNNN.vtu, walls_NNNN.vtu and updates the three .pvd files;
+  // Writes particles_NNNN.vtu, contacts_NNNN.vtu, walls_NNNN.vtu (cell_NNNN.vtu in a periodic cell)
+  // and updates the three .pvd files;
   // `label` is the collection's time value (the axial strain during shearing).
   void write(const Simulation& sim, double label, const PointFields& extra = {});
   const std::vector<double>& labels() const { return labels_; }
@@ -33,6 +34,8 @@ class VtkSeries {
 // The three grids as text (exposed for tests).
 std::string particlesVtu(const Simulation& sim, const PointFields& extra = {});
 std::string contactsVtu(const Simulation& sim);
+// The boundary: six wall quads, or the periodic cell (cellVtu) when the simulation has one.
 std::string wallsVtu(const Simulation& sim);
+std::string cellVtu(const Simulation& sim);
 
 }  // namespace grainlab::io

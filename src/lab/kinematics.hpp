@@ -8,12 +8,15 @@
 // any rigid motion), and the equivalent shear strain eq = sqrt(2/3 e:e) of its deviator e.
 // A grain is in the shear band when its eq is at least `bandFactor` times the eq of the box's own
 // (homogeneous) strain: localisation means grains deforming well above the average.
+// In a periodic cell neighbours are found across the faces too: the image of a neighbour in the
+// reference cell moves with its own displacement plus the cell's deformation of the image shift.
 // Rotation statistics and the band fraction count only grains that take part in the load-bearing
 // network (`active`, e.g. at least two contacts): a rattler touches nothing, feels no damping and
 // keeps whatever spin it had, which says nothing about the band.
 #include <vector>
 
-#include "core/particles.hpp"
+#include "core/simulation.hpp"
+#include "lab/grain_records.hpp"
 
 namespace grainlab::lab {
 
@@ -32,11 +35,9 @@ struct GrainKinematics {
 // Equivalent shear strain sqrt(2/3 e:e) of the deviator of a strain tensor.
 double equivalentShearStrain(const Mat3& strain);
 
-// `boxStrain`: the box's homogeneous Green–Lagrange strain (diagonal for a wall box);
-// `radius`: neighbourhood radius [m]; `bandFactor`: threshold on eq / eq_box.
-// `active`: grains counted in the statistics (empty: all).
-GrainKinematics grainKinematics(const Particles& particles, const std::vector<Vec3>& referencePosition,
-                                const Mat3& boxStrain, double radius, double bandFactor = 2.0,
-                                const std::vector<char>& active = {});
+// `boxStrain`: the sample's homogeneous Green–Lagrange strain; `radius`: neighbourhood radius [m];
+// `bandFactor`: threshold on eq / eq_box; `active`: grains counted in the statistics (empty: all).
+GrainKinematics grainKinematics(const Simulation& sim, const GrainRecords& records, const Mat3& boxStrain,
+                                double radius, double bandFactor = 2.0, const std::vector<char>& active = {});
 
 }  // namespace grainlab::lab

@@ -104,4 +104,52 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
   return m;
 }
 
+MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSettings& s) {
+  MacroParameters m;
+  const std::size_t n = c.eps1.size();
+  if (n < 2 || c.shearStress.size() != n) return m;
+  std::vector<double> ratio(n), phi(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ratio[i] = c.sigma1[i] > 0.0 ? c.shearStress[i] / c.sigma1[i] : 0.0;
+    phi[i] = radToDeg(std::atan(ratio[i]));
+  }
+  const std::size_t peak = std::max_element(phi.begin(), phi.end()) - phi.begin();
+  m.phiPeakDeg = phi[peak];
+  m.eps1AtPeak = c.eps1[peak];
+  m.qPeak = c.shearStress[peak];
+  m.residualFrom = (1.0 - s.residualFraction) * c.eps1.back();
+  double sumPhi = 0.0, sumRatio = 0.0, sumE = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (c.eps1[i] < m.residualFrom) continue;
+    sumPhi += phi[i];
+    sumRatio += ratio[i];
+    sumE += c.voidRatio.empty() ? 0.0 : c.voidRatio[i];
+    ++count;
+  }
+  if (count > 0) {
+    m.phiResDeg = sumPhi / count;
+    m.csStressRatio = sumRatio / count;
+    m.csVoidRatio = sumE / count;
+  }
+  m.psiMaxDeg = -90.0;
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
+    while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
+    if (hi - lo < 3) continue;
+    const double psi = radToDeg(std::atan(-slope(c.eps1, c.epsV, lo, hi)));
+    if (psi > m.psiMaxDeg) {
+      m.psiMaxDeg = psi;
+      m.eps1AtPsiMax = c.eps1[i];
+    }
+  }
+  if (m.psiMaxDeg == -90.0) m.psiMaxDeg = 0.0;
+  std::size_t end = 0;
+  while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
+  end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));
+  m.shearModulus = slope(c.eps1, c.shearStress, 0, end);
+  return m;
+}
+
 }  // namespace grainlab::lab

@@ -11,6 +11,7 @@ struct TriaxialCurves {
   std::vector<double> sigma1;  // [Pa]
   std::vector<double> sigma3;  // mean lateral stress [Pa]
   std::vector<double> voidRatio;
+  std::vector<double> shearStress;  // simple shear: tau [Pa] (sigma1 is then the normal stress)
 };
 
 // Windows used, stated here and in the README:
@@ -37,8 +38,9 @@ struct MacroParameters {
   double youngModulus = 0.0;  // [Pa]
   double e50 = 0.0;           // [Pa]
   double poisson = 0.0;
-  double csStressRatio = 0.0;  // q/p over the residual window
+  double csStressRatio = 0.0;  // q/p over the residual window (simple shear: tau/sigma_n)
   double csVoidRatio = 0.0;
+  double shearModulus = 0.0;  // simple shear: least-squares slope of tau on gamma in the elastic window [Pa]
 };
 
 // phi = asin((sigma1 - sigma3)/(sigma1 + sigma3)) [deg]
@@ -49,5 +51,10 @@ double dilatancyAngleDeg(double rate);
 double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t begin, std::size_t end);
 
 MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s = {});
+// Simple shear at constant normal stress: `eps1` holds gamma, `sigma1` the normal stress, and
+// `shearStress` tau. phi = atan(tau / sigma_n); psi = atan(-d eps_v / d gamma) (positive in
+// dilation); G the slope of tau on gamma over gamma <= elasticWindow; windows as for computeMacro.
+// E, E50 and nu stay 0 (not measured by this test).
+MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSettings& s = {});
 
 }  // namespace grainlab::lab

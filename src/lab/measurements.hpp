@@ -1,5 +1,6 @@
 #pragma once
-// What is measured on an assembly in a wall box (PHYSICS.md §7.1, §7.2, §7.5 in part).
+// What is measured on an assembly, in a wall box or a periodic cell (PHYSICS.md §7.1, §7.2, §7.5
+// in part).
 #include "core/simulation.hpp"
 
 namespace grainlab::lab {
@@ -8,19 +9,26 @@ namespace grainlab::lab {
 // particle-wall contacts). Quasi-static when small (e.g. < 0.01). Zero contacts gives 1.
 double unbalancedForceRatio(const Simulation& sim);
 
-// Love–Weber stress from contacts, compression positive: sigma = (1/V) sum_p sum_c f^c (x^c - x^p)
-// with the sign flipped, over all contacts of every particle, walls included (the per-particle form
-// of [O] eq. 2.3). For a particle pair it reduces to f_AB (x) branch. V is the box volume.
+// Love–Weber stress from contacts, compression positive: sigma = -(1/V) sum_p sum_c f^c (x^c - x^p)
+// over all contacts of every particle, walls included (the per-particle form of [O] eq. 2.3). For a
+// particle pair it reduces to f_AB (x) branch (the branch to the periodic image across a face). The
+// full tensor: its skew part is a check (zero without contact moments at equilibrium).
 Mat3 contactStress(const Simulation& sim);
 
-// Wall stresses (sigma_xx, sigma_yy, sigma_zz), compression positive [Pa].
-Vec3 wallStress(const Simulation& sim);
+// The boundary's stresses (sigma_xx, sigma_yy, sigma_zz), compression positive [Pa]: the wall
+// stresses (mean of the two opposite walls) in a box, the symmetrised contact stress in a cell.
+Vec3 boundaryStress(const Simulation& sim);
+// Every wall's own stress (k = 2 axis + side) [Pa]; zeros in a periodic cell.
+std::array<double, 6> singleWallStresses(const Simulation& sim);
+// Lengths of the sample along x, y, z [m]: the box's, or the cell's diagonal of H.
+Vec3 sampleLengths(const Simulation& sim);
 
 double voidRatio(const Simulation& sim);
 // Touching contacts of every particle, wall contacts included.
 std::vector<int> contactsPerParticle(const Simulation& sim);
 // Z = 2 Nc / Np over touching particle-particle contacts.
 double coordinationNumber(const Simulation& sim);
+// Kinetic energy of the particles' (fluctuating) translations and their rotations [J].
 double kineticEnergy(const Simulation& sim);
 // Elastic energy stored in the contact springs (normal, shear, moment) [J].
 double elasticEnergy(const Simulation& sim);

@@ -5,48 +5,45 @@
 #include <functional>
 #include <numeric>
 
+#include "core/spatial_grid.hpp"
+
 namespace grainlab::lab {
 
 namespace {
 
-struct Grid {
-  double side;
-  int dim;
-  std::vector<std::vector<std::uint32_t>> cells;
-  Grid(double boxSide, double cellSide)
-      : side(cellSide), dim(std::max(1, static_cast<int>(boxSide / cellSide))),
-        cells(static_cast<std::size_t>(dim) * dim * dim) {}
-  int coord(double v) const { return std::clamp(static_cast<int>(v / side), 0, dim - 1); }
-  std::size_t index(int x, int y, int z) const { return (static_cast<std::size_t>(z) * dim + y) * dim + x; }
-};
-
-bool tryPlace(const std::vector<double>& radii, double boxSide, Rng& rng, std::vector<Vec3>& pos) {
+bool tryPlace(const std::vector<double>& radii, double boxSide, bool periodic, Rng& rng, std::vector<Vec3>& pos) {
   const double rMax = radii.front();
-  Grid grid(boxSide, 2.0 * rMax);
+  const double cellSide = 2.0 * rMax;
+  const int dim = SpatialGrid::cellsAlong(boxSide, cellSide);
+  // In a cell, the grid's cells tile the period exactly, so that the wrapped block finds images.
+  const double side = periodic ? boxSide / dim : cellSide;
+  SpatialGrid grid;
+  grid.reset({dim, dim, dim});
   pos.assign(radii.size(), Vec3::Zero());
   for (std::size_t i = 0; i < radii.size(); ++i) {
     const double r = radii[i];
     bool placed = false;
     for (int attempt = 0; attempt < 2000 && !placed; ++attempt) {
-      const Vec3 x(rng.uniform(r, boxSide - r), rng.uniform(r, boxSide - r), rng.uniform(r, boxSide - r));
-      const int cx = grid.coord(x[0]), cy = grid.coord(x[1]), cz = grid.coord(x[2]);
+      const double lo = periodic ? 0.0 : r, hi = periodic ? boxSide : boxSide - r;
+      const Vec3 x(rng.uniform(lo, hi), rng.uniform(lo, hi), rng.uniform(lo, hi));
+      SpatialGrid::Cell c{};
+      for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(x[a], 0.0, side, dim);
       bool free = true;
-      for (int dz = -1; dz <= 1 && free; ++dz)
-        for (int dy = -1; dy <= 1 && free; ++dy)
-          for (int dx = -1; dx <= 1 && free; ++dx) {
-            const int X = cx + dx, Y = cy + dy, Z = cz + dz;
-            if (X < 0 || Y < 0 || Z < 0 || X >= grid.dim || Y >= grid.dim || Z >= grid.dim) continue;
-            for (std::uint32_t j : grid.cells[grid.index(X, Y, Z)]) {
-              const double reach = r + radii[j];
-              if ((pos[j] - x).squaredNorm() < reach * reach) {
-                free = false;
-                break;
-              }
-            }
-          }
+      auto check = [&](std::uint32_t j, const Vec3& image) {
+        const double reach = r + radii[j];
+        if ((image - x).squaredNorm() < reach * reach) free = false;
+      };
+      if (periodic)
+        grid.forEachAroundPeriodic(c, [&](std::uint32_t j, const SpatialGrid::Cell& s) {
+          if (free) check(j, pos[j] + boxSide * Vec3(s[0], s[1], s[2]));
+        });
+      else
+        grid.forEachAround(c, [&](std::uint32_t j) {
+          if (free) check(j, pos[j]);
+        });
       if (free) {
         pos[i] = x;
-        grid.cells[grid.index(cx, cy, cz)].push_back(static_cast<std::uint32_t>(i));
+        grid.insert(static_cast<std::uint32_t>(i), c);
         placed = true;
       }
     }
@@ -57,8 +54,8 @@ bool tryPlace(const std::vector<double>& radii, double boxSide, Rng& rng, std::v
 
 }  // namespace
 
-void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng,
-                Particles& particles, WallBox& box) {
+void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim) {
+  const bool periodic = sim.boundary == Boundary::Periodic;
   std::sort(diameters.begin(), diameters.end(), std::greater<>());
   std::vector<double> radii(diameters.size());
   double solid = 0.0;
@@ -69,19 +66,24 @@ void placeLoose(std::vector<double> diameters, double density, double voidRatio,
   double side = std::cbrt(solid * (1.0 + voidRatio));
   side = std::max(side, 2.0 * diameters.front());
   std::vector<Vec3> pos;
-  while (!tryPlace(radii, side, rng, pos)) side *= 1.05;
+  while (!tryPlace(radii, side, periodic, rng, pos)) side *= 1.05;
 
   // Renumber in cell order (z, y, x) of cells about one large diameter wide.
-  Grid grid(side, diameters.front());
+  const int dim = SpatialGrid::cellsAlong(side, diameters.front());
+  SpatialGrid grid;
+  grid.reset({dim, dim, dim});
   std::vector<std::size_t> order(radii.size());
   std::iota(order.begin(), order.end(), 0);
   auto key = [&](std::size_t i) {
-    return grid.index(grid.coord(pos[i][0]), grid.coord(pos[i][1]), grid.coord(pos[i][2]));
+    SpatialGrid::Cell c{};
+    for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(pos[i][a], 0.0, diameters.front(), dim);
+    return grid.cellIndex(c);
   };
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
-  particles = Particles{};
-  for (std::size_t i : order) particles.addSphere(pos[i], radii[i], density);
-  box.setBounds(Vec3::Zero(), Vec3::Constant(side));
+  sim.particles = Particles{};
+  for (std::size_t i : order) sim.particles.addSphere(pos[i], radii[i], density);
+  if (periodic) sim.cell.setBox(Vec3::Constant(side));
+  else sim.box.setBounds(Vec3::Zero(), Vec3::Constant(side));
 }
 
 }  // namespace grainlab::lab

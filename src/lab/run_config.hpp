@@ -33,6 +33,11 @@ struct SampleConfig {
   double prepStiffnessFactor = 0.01;  // contact stiffness during compaction, as a fraction of Ec
   double prepDamping = 0.3;           // local damping during compaction
   long prepRampSteps = 20000;         // steps of the geometric ramp from the soft to the full Ec
+  // "compaction": the boundary's servo compacts the loose sample with the preparation friction
+  // (searched to meet e0 when prep_friction_deg is "auto"); "growth": frictionless radius growth with
+  // the boundary held still up to the confining pressure (the densest state; e0 is a result).
+  std::string method = "compaction";
+  double growthRate = 2e-5;           // relative radius growth per step (method "growth")
 };
 
 struct SphericityConfig {
@@ -56,11 +61,16 @@ struct ContactConfig {
 };
 
 struct TestConfig {
-  std::string type = "triaxial";      // "isotropic" | "triaxial"
-  std::string boundary = "walls";
-  double confiningPressure = 100.0e3; // [Pa]
+  // "isotropic" | "triaxial" | "constant-p" | "true-triaxial" | "simple-shear" (periodic only)
+  std::string type = "triaxial";
+  std::string boundary = "walls";     // "walls" | "periodic"
+  double confiningPressure = 100.0e3; // [Pa]; the mean stress of constant-p and true-triaxial, the
+                                      // normal stress of simple-shear
   std::optional<double> axialStrainRate = 0.5;  // [1/s]; nullopt = "auto"
   double finalAxialStrain = 0.20;     // [-]
+  double b = 0.5;                     // true-triaxial: (sigma2 - sigma3)/(sigma1 - sigma3)
+  std::optional<double> shearStrainRate;  // simple-shear [1/s]; nullopt = "auto"
+  double finalShearStrain = 0.5;      // simple-shear: final gamma [-]
 };
 
 struct SolverConfig {

@@ -131,18 +131,20 @@ TEST(Sphericity, FileErrorsNameTheProblem) {
 // A rigid rotation of the whole sample: every grain's rotation is the imposed one, and no grain
 // shows local strain or belongs to a band.
 TEST(Kinematics, PrescribedRigidRotation) {
-  Particles p;
+  Simulation sim;
+  Particles& p = sim.particles;
   lab::Rng rng(5);
   for (int i = 0; i < 300; ++i)
     p.addSphere(Vec3(rng.uniform(0, 0.05), rng.uniform(0, 0.05), rng.uniform(0, 0.05)), 2e-3, 2600.0);
-  p.resetKinematicReference();
+  lab::GrainRecords records;
+  records.reset(sim);
   const Eigen::AngleAxisd rotation(degToRad(17.0), Vec3(1.0, 2.0, 0.5).normalized());
   const Vec3 centre(0.025, 0.025, 0.025);
   for (std::size_t i = 0; i < p.size(); ++i) {
     p.position[i] = centre + rotation * (p.position[i] - centre);
     p.orientation[i] = Quat(rotation) * p.orientation[i];
   }
-  const lab::GrainKinematics k = lab::grainKinematics(p, p.referencePosition, Mat3::Zero(), 0.012);
+  const lab::GrainKinematics k = lab::grainKinematics(sim, records, Mat3::Zero(), 0.012);
   for (std::size_t i = 0; i < p.size(); ++i) {
     EXPECT_NEAR(k.rotationDeg[i], 17.0, 1e-9);
     EXPECT_LT(k.localShearStrain[i], 1e-12);
@@ -154,30 +156,32 @@ TEST(Kinematics, PrescribedRigidRotation) {
 
 // A band of simple shear through the middle of a block: the sheared layer is detected as the band.
 TEST(Kinematics, ShearBandIsDetected) {
-  Particles p;
+  Simulation sim;
+  Particles& p = sim.particles;
   for (int x = 0; x < 12; ++x)
     for (int y = 0; y < 12; ++y)
       for (int z = 0; z < 12; ++z) p.addSphere(Vec3(x, y, z) * 4e-3, 2e-3, 2600.0);
-  p.resetKinematicReference();
+  lab::GrainRecords records;
+  records.reset(sim);
   // Displacement along x that grows with z only inside 20 mm < z < 28 mm (a shear of 0.2 there).
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double z = p.referencePosition[i].z();
+    const double z = records.referencePosition[i].z();
     p.position[i].x() += 0.2 * std::clamp(z - 0.020, 0.0, 0.008);
   }
   // The box's average shear: 0.2 * 8 mm over 44 mm, as a pure-shear-equivalent diagonal strain.
   Mat3 box = Mat3::Zero();
   box(0, 2) = box(2, 0) = 0.5 * 0.2 * 8.0 / 44.0;
-  const lab::GrainKinematics k = lab::grainKinematics(p, p.referencePosition, box, 4.5e-3);
+  const lab::GrainKinematics k = lab::grainKinematics(sim, records, box, 4.5e-3);
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double z = p.referencePosition[i].z();
+    const double z = records.referencePosition[i].z();
     if (z > 0.0205 && z < 0.0275) EXPECT_EQ(k.inBand[i], 1.0) << "z = " << z;
     if (z < 0.015 || z > 0.033) EXPECT_EQ(k.inBand[i], 0.0) << "z = " << z;
   }
   // The threshold is the band factor: the layer shears ~44/8 = 5.5 times more than the box on
   // average, so a factor of 20 finds no band and a lower factor finds at least the same grains.
   EXPECT_GT(k.bandFraction, 0.0);
-  const lab::GrainKinematics strict = lab::grainKinematics(p, p.referencePosition, box, 4.5e-3, 20.0);
+  const lab::GrainKinematics strict = lab::grainKinematics(sim, records, box, 4.5e-3, 20.0);
   EXPECT_EQ(strict.bandFraction, 0.0);
-  const lab::GrainKinematics loose = lab::grainKinematics(p, p.referencePosition, box, 4.5e-3, 1.2);
+  const lab::GrainKinematics loose = lab::grainKinematics(sim, records, box, 4.5e-3, 1.2);
   EXPECT_GE(loose.bandFraction, k.bandFraction);
 }

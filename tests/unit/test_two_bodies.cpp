@@ -71,7 +71,7 @@ TEST(ShearForce, RigidRotationOfLoadedContact) {
   }
   sim.particles.velocity[1].setZero();
   sim.step();
-  const Vec3 fs0 = sim.pairForce[0] - sim.pairForce[0].dot(Vec3::UnitX()) * Vec3::UnitX();
+  const Vec3 fs0 = sim.contacts.sphereSphere.force[0] - sim.contacts.sphereSphere.force[0].dot(Vec3::UnitX()) * Vec3::UnitX();
   const double ks = sim.model.pairParams(R, R).ks;
   EXPECT_NEAR(fs0.y(), -ks * 1e-8, 1e-6 * ks * 1e-8);  // elastic, opposing B's slip
   // Rigid rotation about z through the midpoint at Omega: each step the velocities are those of the
@@ -94,7 +94,7 @@ TEST(ShearForce, RigidRotationOfLoadedContact) {
   // The normal at which the force is evaluated (positions move during the step).
   const Vec3 n = (sim.particles.position[1] - sim.particles.position[0]).normalized();
   sim.step();
-  const Vec3 f = sim.pairForce[0];
+  const Vec3 f = sim.contacts.sphereSphere.force[0];
   const Vec3 fs = f - f.dot(n) * n;
   EXPECT_NEAR(fs.norm() / fs0.norm(), 1.0, 1e-6);
   EXPECT_NEAR(std::abs(fs.normalized().dot(n)), 0.0, 1e-9);

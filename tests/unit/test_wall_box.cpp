@@ -19,7 +19,7 @@ TEST(IsotropicEquilibrium, ContactStressEqualsWallStress) {
   omp_set_num_threads(2);
   lab::Laboratory lab(c);
   const lab::PreparationResult prep = lab.prepare();
-  const Vec3 walls = prep.state.wallStress;
+  const Vec3 walls = prep.state.boundaryStress;
   const Mat3 contacts = prep.state.contactStress;
   for (int a = 0; a < 3; ++a) {
     EXPECT_NEAR(walls[a] / 100e3, 1.0, 0.01) << "axis " << a;

@@ -1,0 +1,163 @@
+#include "core/broad_phase.hpp"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "core/state_io.hpp"
+
+namespace grainlab {
+
+void BroadPhase::saveState(std::ostream& out) const {
+  using namespace stateio;
+  put(out, skin);
+  put(out, builds);
+  putVector(out, positionAtBuild_);
+  put(out, wallPositionAtBuild_);
+  put(out, cellAtBuildInverse_);
+}
+
+void BroadPhase::loadState(std::istream& in) {
+  using namespace stateio;
+  get(in, skin);
+  get(in, builds);
+  getVector(in, positionAtBuild_);
+  get(in, wallPositionAtBuild_);
+  get(in, cellAtBuildInverse_);
+}
+
+void BroadPhase::permute(const std::vector<std::uint32_t>& order) {
+  if (positionAtBuild_.size() != order.size()) return;
+  std::vector<Vec3> p(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) p[k] = positionAtBuild_[order[k]];
+  positionAtBuild_.swap(p);
+}
+
+bool BroadPhase::wallsMoved(const WallBox& box) const {
+  for (int k = 0; k < 6; ++k)
+    if (std::abs(box.walls[k].position - wallPositionAtBuild_[k]) > halfSkin()) return true;
+  return false;
+}
+
+double BroadPhase::reach(const Particles& particles) const {
+  double rMax = 0.0;
+  for (double r : particles.radius) rMax = std::max(rMax, r);
+  return 2.0 * rMax + skin;
+}
+
+template <class Partners>
+std::vector<PairKey> BroadPhase::scanPairs(std::size_t n, Partners&& partners) {
+  // Each thread scans a contiguous range of a and lists its partners (b > a) in sorted order;
+  // ranges are concatenated in thread order, so the result equals the serial one.
+  const int nThreads = omp_get_max_threads();
+  std::vector<std::vector<PairKey>> perThread(nThreads);
+#pragma omp parallel num_threads(nThreads)
+  {
+    const int t = omp_get_thread_num();
+    const int nt = omp_get_num_threads();
+    const std::size_t begin = n * t / nt, end = n * (t + 1) / nt;
+    auto& out = perThread[t];
+    std::vector<PairKey> found;
+    for (std::size_t a = begin; a < end; ++a) {
+      found.clear();
+      partners(static_cast<std::uint32_t>(a), found);
+      std::sort(found.begin(), found.end());
+      out.insert(out.end(), found.begin(), found.end());
+    }
+  }
+  std::vector<PairKey> keys;
+  std::size_t total = 0;
+  for (auto& v : perThread) total += v.size();
+  keys.reserve(total);
+  for (auto& v : perThread) keys.insert(keys.end(), v.begin(), v.end());
+  return keys;
+}
+
+void BroadPhase::buildWalls(const Particles& particles, const WallBox& box, ContactStore& contacts) {
+  const std::size_t n = particles.size();
+  const auto& x = particles.position;
+  const auto& r = particles.radius;
+
+  // Grid over the particles' bounding box; cell side >= largest interaction distance.
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  double rMax = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+    rMax = std::max(rMax, r[i]);
+  }
+  const double cellSide = 2.0 * rMax + skin;
+  SpatialGrid::Cell dims{};
+  for (int a = 0; a < 3; ++a) dims[a] = SpatialGrid::cellsAlong(hi[a] - lo[a], cellSide);
+  auto cellOf = [&](const Vec3& p) {
+    SpatialGrid::Cell c{};
+    for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(p[a], lo[a], cellSide, dims[a]);
+    return c;
+  };
+  grid_.reset(dims);
+  for (std::size_t i = 0; i < n; ++i) grid_.insert(static_cast<std::uint32_t>(i), cellOf(x[i]));
+
+  const std::vector<PairKey> keys = scanPairs(n, [&](std::uint32_t a, std::vector<PairKey>& found) {
+    grid_.forEachAround(cellOf(x[a]), [&](std::uint32_t b) {
+      if (b <= a) return;
+      const double reach = r[a] + r[b] + skin;
+      if ((x[b] - x[a]).squaredNorm() < reach * reach) found.push_back({a, b, ImageShift::kZero});
+    });
+  });
+  contacts.sphereSphere.assign(keys, n);
+
+  // Wall candidates, sorted by particle then wall.
+  std::vector<PairKey> wallKeys;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 6; ++k)
+      if (box.walls[k].distance(x[i]) < r[i] + skin)
+        wallKeys.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), ImageShift::kZero});
+  contacts.sphereWall.assign(wallKeys, n);
+
+  positionAtBuild_ = x;
+  for (int k = 0; k < 6; ++k) wallPositionAtBuild_[k] = box.walls[k].position;
+  ++builds;
+}
+
+void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& cell, ContactStore& contacts) {
+  const std::size_t n = particles.size();
+  const auto& x = particles.position;
+  const auto& r = particles.radius;
+  const double range = reach(particles);
+  const Vec3 widths = cell.widths();
+  if (widths.minCoeff() < 2.0 * range)
+    throw SimulationError(fmt::format(
+        "periodic cell too small: its narrowest width {:.4g} m is under twice the interaction range "
+        "{:.4g} m (largest diameter plus skin), so a particle could touch two images of another; use "
+        "more particles (at least ~3 largest diameters per side)", widths.minCoeff(), range));
+  // Grid in scaled coordinates: n_k cells along axis k, each at least `range` wide in real space
+  // (the distance between the cell's faces is widths_k / n_k), so everything within range of a
+  // point is in the 3x3x3 block around its cell (PHYSICS.md §5.2).
+  const SpatialGrid::Cell dims = SpatialGrid::dimsFor({widths[0], widths[1], widths[2]}, range, std::max<std::size_t>(27, 4 * n));
+  std::vector<SpatialGrid::Cell> cellOf(n);
+  grid_.reset(dims);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 s = cell.hInverse * x[i];
+    for (int a = 0; a < 3; ++a) cellOf[i][a] = SpatialGrid::coordinate(s[a] * dims[a], 0.0, 1.0, dims[a]);
+    grid_.insert(static_cast<std::uint32_t>(i), cellOf[i]);
+  }
+  const std::vector<PairKey> keys = scanPairs(n, [&](std::uint32_t a, std::vector<PairKey>& found) {
+    grid_.forEachAroundPeriodic(cellOf[a], [&](std::uint32_t b, const SpatialGrid::Cell& s) {
+      if (b <= a) return;
+      const Vec3 image = x[b] + cell.h * Vec3(s[0], s[1], s[2]);
+      const double reachAB = r[a] + r[b] + skin;
+      if ((image - x[a]).squaredNorm() < reachAB * reachAB) found.push_back({a, b, ImageShift::pack(s[0], s[1], s[2])});
+    });
+  });
+  contacts.sphereSphere.assign(keys, n);
+  contacts.sphereWall.assign({}, n);
+
+  positionAtBuild_ = x;
+  cellAtBuildInverse_ = cell.hInverse;
+  ++builds;
+}
+
+}  // namespace grainlab

@@ -1,0 +1,57 @@
+#pragma once
+// Broad phase: a Verlet list with a skin, built from the spatial grid (O(N)). A pair is listed when
+// its bodies' bounding spheres come within the skin of each other; the lists stay valid while no
+// particle (or wall) has moved more than skin/2 relative to where it was at the last build — in a
+// periodic cell relative to where the homogeneous deformation since then has carried it, and while
+// that deformation itself has not closed gaps by more than the skin.
+#include <array>
+#include <cstdint>
+#include <iosfwd>
+#include <vector>
+
+#include "core/contact_list.hpp"
+#include "core/particles.hpp"
+#include "core/periodic_cell.hpp"
+#include "core/spatial_grid.hpp"
+#include "core/walls.hpp"
+
+namespace grainlab {
+
+class BroadPhase {
+ public:
+  double skin = 0.0;  // [m]
+  long builds = 0;
+
+  // Rebuilds every kind's list for the current positions in a box of walls, carrying history.
+  void buildWalls(const Particles& particles, const WallBox& box, ContactStore& contacts);
+  // The same in a periodic cell; particles must lie in the cell (scaled coordinates in [0, 1)).
+  // Throws SimulationError when the cell is narrower than two interaction ranges.
+  void buildPeriodic(const Particles& particles, const PeriodicCell& cell, ContactStore& contacts);
+
+  double halfSkin() const { return 0.5 * skin; }
+  // Whether a wall moved more than skin/2 since the last build.
+  bool wallsMoved(const WallBox& box) const;
+  // Largest distance at which two bodies can interact: twice the largest bounding radius plus skin.
+  double reach(const Particles& particles) const;
+  // Narrowest a periodic cell may be for these particles: no body may touch two images of another.
+  double minimumCellWidth(const Particles& particles) const { return 2.0 * reach(particles); }
+  // Deformation of the cell since the last build, F = H H_build^-1.
+  Mat3 cellDeformation(const PeriodicCell& cell) const { return cell.h * cellAtBuildInverse_; }
+
+  const std::vector<Vec3>& positionsAtBuild() const { return positionAtBuild_; }
+  void permute(const std::vector<std::uint32_t>& order);
+
+  void saveState(std::ostream& out) const;
+  void loadState(std::istream& in);
+
+ private:
+  std::vector<Vec3> positionAtBuild_;
+  std::array<double, 6> wallPositionAtBuild_{};
+  Mat3 cellAtBuildInverse_ = Mat3::Identity();
+  SpatialGrid grid_;
+  // Sorted keys of every particle pair within reach, from a parallel scan of `partners`.
+  template <class Partners>
+  std::vector<PairKey> scanPairs(std::size_t n, Partners&& partners);
+};
+
+}  // namespace grainlab

@@ -1,0 +1,208 @@
+#pragma once
+// The one contact driver, instantiated per pair kind (and boundary): for every candidate of a kind's
+// list it asks the kind's narrow phase for the geometry, applies the contact law (slots of
+// contact/models.hpp) with the pair's parameters and the contact's history, and writes the result
+// slots. Geometry x parameters x history -> force (YADE's Ig2 / Ip2 / Law2). No virtual call or
+// switch per contact: the kind is a template argument.
+//
+// Parameters (the Ip2 step) are computed from the two bodies when a contact is evaluated rather than
+// stored per contact: for spheres they are a handful of multiplications and one division, cheaper
+// than reading 48 stored bytes per contact per step, and they follow a stiffness change (the
+// preparation's stiffness ramp) without a pass over the contacts (bench/NOTES.md has the measurement).
+#include "contact/models.hpp"
+#include "core/contact_list.hpp"
+#include "core/parallel.hpp"
+#include "core/particles.hpp"
+#include "core/periodic_cell.hpp"
+#include "core/walls.hpp"
+#include "geometry/sphere_contacts.hpp"
+
+namespace grainlab {
+
+// What a kernel reads besides its own list.
+struct ContactContext {
+  const Particles& particles;
+  const contact::SphereContactModel& model;
+  const WallBox& box;
+  const PeriodicCell& cell;
+  double dt;
+};
+
+// Terms summed per chunk of contacts (deterministic, see parallel.hpp).
+enum ContactSum : int {
+  kSlip = 0,
+  kRoll,
+  // Periodic cell only: Love–Weber stress terms f_i l_j (9) and the servo's affine stiffnesses
+  // (3 normal: xx, yy, zz; 3 shear: yz, xz, xy).
+  kStress0,
+  kStiffness0 = kStress0 + 9,
+  kShearStiffness0 = kStiffness0 + 3,
+  kContactSums = kShearStiffness0 + 3,
+};
+
+namespace detail {
+
+// The narrow phase and kinematics of one contact of a kind: fills geometry and kinematics and
+// returns false when the bodies are apart.
+template <class Kind, bool Periodic>
+struct KindKernel;
+
+template <bool Periodic>
+struct KindKernel<SphereSphere, Periodic> {
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const ContactList<SphereSphere>& list,
+                                              std::size_t c, geometry::ContactGeometry& g, Vec3& branch) {
+    const auto& x = ctx.particles.position;
+    const auto& rad = ctx.particles.radius;
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    if constexpr (Periodic) branch = x[b] + ctx.cell.shiftVector(list.shift[c]) - x[a];
+    else branch = x[b] - x[a];
+    const double dist2 = branch.squaredNorm();
+    const double reach = rad[a] + rad[b];
+    if (dist2 >= reach * reach) return false;
+    g = geometry::sphereSphere(branch, dist2, rad[a], rad[b]);
+    return true;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx,
+                                                                      const ContactList<SphereSphere>& list,
+                                                                      std::size_t c,
+                                                                      const geometry::ContactGeometry& g,
+                                                                      const Vec3& branch) {
+    const auto& v = ctx.particles.velocity;
+    const auto& w = ctx.particles.angularVelocity;
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    contact::ContactKinematics k;
+    k.normal = g.normal;
+    k.overlap = g.overlap;
+    k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
+    // In a periodic cell the bodies' velocities are fluctuations about the homogeneous flow, whose
+    // relative velocity across the branch (image shift included) is L l (PHYSICS.md §2, §5.2).
+    if constexpr (Periodic) k.relativeVelocity += ctx.cell.velocityGradient * branch;
+    k.relativeSpin = w[b] - w[a];
+    k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
+    k.dt = ctx.dt;
+    return k;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx,
+                                                           const ContactList<SphereSphere>& list, std::size_t c) {
+    const auto& rad = ctx.particles.radius;
+    const auto& mu = ctx.particles.rollingFriction;
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    return ctx.model.pairParams(rad[a], rad[b], mu[a], mu[b]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(ContactList<SphereSphere>& list, std::size_t c,
+                                           const geometry::ContactGeometry& g, const contact::ContactResponse& res) {
+    list.force[c] = res.force;
+    list.torqueA[c] = g.branchA.cross(-res.force) + res.moment;
+    list.torqueB[c] = g.branchB.cross(res.force) - res.moment;
+  }
+};
+
+template <bool Periodic>
+struct KindKernel<SpherePlane, Periodic> {
+  // The wall is body A, the sphere body B (the plane's normal points into the sphere's side).
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const ContactList<SpherePlane>& list,
+                                              std::size_t c, geometry::ContactGeometry& g, Vec3&) {
+    const auto& x = ctx.particles.position;
+    const std::uint32_t i = list.a[c];
+    const Wall& wall = ctx.box.walls[list.b[c]];
+    const Vec3 n = wall.inwardNormal();
+    Vec3 planePoint = x[i];
+    planePoint[wall.axis] = wall.position;
+    g = geometry::spherePlane(x[i], ctx.particles.radius[i], planePoint, n);
+    return g.overlap > 0.0;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx,
+                                                                      const ContactList<SpherePlane>& list,
+                                                                      std::size_t c,
+                                                                      const geometry::ContactGeometry& g,
+                                                                      const Vec3&) {
+    const auto& v = ctx.particles.velocity;
+    const auto& w = ctx.particles.angularVelocity;
+    const std::uint32_t i = list.a[c];
+    const Wall& wall = ctx.box.walls[list.b[c]];
+    Vec3 wallVelocity = Vec3::Zero();
+    wallVelocity[wall.axis] = wall.velocity;
+    contact::ContactKinematics k;
+    k.normal = g.normal;
+    k.overlap = g.overlap;
+    k.relativeVelocity = v[i] + w[i].cross(g.branchB) - wallVelocity;
+    k.relativeSpin = w[i];
+    k.meanSpinNormal = 0.5 * w[i].dot(g.normal);
+    k.dt = ctx.dt;
+    return k;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx,
+                                                           const ContactList<SpherePlane>& list, std::size_t c) {
+    const std::uint32_t i = list.a[c];
+    return ctx.model.wallParams(ctx.particles.radius[i], ctx.box.walls[list.b[c]].tanFriction,
+                                ctx.particles.rollingFriction[i]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(ContactList<SpherePlane>& list, std::size_t c,
+                                           const geometry::ContactGeometry& g, const contact::ContactResponse& res) {
+    list.force[c] = res.force;
+    list.torqueA[c] = g.branchB.cross(res.force) - res.moment;
+  }
+};
+
+}  // namespace detail
+
+// Evaluates every contact of `list`; call inside an OpenMP parallel region (the loop is a
+// work-shared `omp for` without a barrier at its end). `sums` holds kContactSums terms per chunk
+// when Periodic, else kSlip and kRoll.
+template <class Kind, bool Periodic>
+void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, ChunkedSums& sums, bool writeAll) {
+  using Kernel = detail::KindKernel<Kind, Periodic>;
+  // Chunks are scheduled dynamically: only touching pairs run the contact law.
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
+    double slip = 0.0, roll = 0.0;
+    Mat3 stress = Mat3::Zero();
+    Vec3 stiffness = Vec3::Zero(), shearStiffness = Vec3::Zero();
+    for (std::size_t c = sums.begin(chunk); c < sums.end(chunk); ++c) {
+      typename Kind::History& h = list.history[c];
+      geometry::ContactGeometry g;
+      Vec3 branch;
+      if (!Kernel::evaluate(ctx, list, c, g, branch)) {
+        // A pair that was apart and still is keeps its zero slots, so it is skipped without a write.
+        if (!h.touching && !writeAll) continue;
+        h = typename Kind::History{};
+        list.force[c].setZero();
+        list.torqueA[c].setZero();
+        if constexpr (!Kind::kPlane) list.torqueB[c].setZero();
+        continue;
+      }
+      if (!h.touching) {
+        h.touching = true;
+        h.prevNormal = g.normal;
+      }
+      contact::ContactKinematics k = Kernel::kinematics(ctx, list, c, g, branch);
+      k.prevNormal = h.prevNormal;
+      const contact::PairParams p = Kernel::params(ctx, list, c);
+      const contact::ContactResponse res = contact::applyLaw(p, k, h);
+      Kernel::store(list, c, g, res);
+      slip += res.slipDissipation;
+      roll += res.rollDissipation;
+      if constexpr (Periodic && !Kind::kPlane) {
+        stress += res.force * branch.transpose();
+        const Vec3 n2 = g.normal.cwiseProduct(g.normal);
+        const double l2 = branch.squaredNorm();
+        stiffness += l2 * n2.cwiseProduct(p.kn * n2 + p.ks * (Vec3::Ones() - n2));
+        // Pure shear e in the (i, j) plane: l2 (2 kn ni^2 nj^2 + ks ((ni^2 + nj^2)/2 - 2 ni^2 nj^2)).
+        for (int k = 0; k < 3; ++k) {
+          const int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+          const double ninj = n2[i] * n2[j];
+          shearStiffness[k] += l2 * (2.0 * p.kn * ninj + p.ks * (0.5 * (n2[i] + n2[j]) - 2.0 * ninj));
+        }
+      }
+    }
+    sums.at(chunk, kSlip) = slip;
+    sums.at(chunk, kRoll) = roll;
+    if constexpr (Periodic) {
+      for (int i = 0; i < 9; ++i) sums.at(chunk, kStress0 + i) = stress(i % 3, i / 3);
+      for (int i = 0; i < 3; ++i) sums.at(chunk, kStiffness0 + i) = stiffness[i];
+      for (int i = 0; i < 3; ++i) sums.at(chunk, kShearStiffness0 + i) = shearStiffness[i];
+    }
+  }
+}
+
+}  // namespace grainlab

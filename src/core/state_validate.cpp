@@ -1,0 +1,82 @@
+// Checks of a state read from a checkpoint, before anything is built from it: a checksum catches
+// accidental corruption, these checks catch a file that is well-formed but inconsistent.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "core/simulation.hpp"
+
+namespace grainlab {
+
+namespace {
+
+[[noreturn]] void bad(const std::string& what) { throw std::runtime_error("inconsistent state: " + what); }
+
+template <class T>
+void sameSize(const std::vector<T>& v, std::size_t n, const char* name) {
+  if (v.size() != n) bad(fmt::format("{} has {} entries for {} particles", name, v.size(), n));
+}
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace
+
+void Simulation::validateState() const {
+  const Particles& P = particles;
+  const std::size_t n = P.size();
+  if (n == 0) bad("no particles");
+  sameSize(P.id, n, "id");
+  sameSize(P.velocity, n, "velocity");
+  sameSize(P.orientation, n, "orientation");
+  sameSize(P.angularVelocity, n, "angular velocity");
+  sameSize(P.force, n, "force");
+  sameSize(P.torque, n, "torque");
+  sameSize(P.shape, n, "shape");
+  sameSize(P.radius, n, "radius");
+  sameSize(P.semiAxes, n, "semi-axes");
+  sameSize(P.mass, n, "mass");
+  sameSize(P.inertia, n, "inertia");
+  sameSize(P.rollingFriction, n, "rolling friction");
+  sameSize(P.image, n, "image");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!finite(P.position[i]) || !finite(P.velocity[i]) || !finite(P.angularVelocity[i]) ||
+        !P.orientation[i].coeffs().allFinite())
+      bad(fmt::format("particle {}: non-finite state", i));
+    if (P.shape[i] != Shape::Sphere && P.shape[i] != Shape::Ellipsoid) bad(fmt::format("particle {}: unknown shape", i));
+    if (!(P.radius[i] > 0.0) || !std::isfinite(P.radius[i]) || !(P.semiAxes[i].minCoeff() > 0.0) ||
+        !finite(P.semiAxes[i]))
+      bad(fmt::format("particle {}: size not positive and finite", i));
+    if (!(P.mass[i] > 0.0) || !std::isfinite(P.mass[i]) || !(P.inertia[i] > 0.0) || !std::isfinite(P.inertia[i]))
+      bad(fmt::format("particle {}: mass or inertia not positive and finite", i));
+    if (std::abs(P.orientation[i].norm() - 1.0) > 1e-6) bad(fmt::format("particle {}: orientation not a unit quaternion", i));
+  }
+  if (boundary != Boundary::Walls && boundary != Boundary::Periodic) bad("unknown boundary");
+  if (boundary == Boundary::Periodic) {
+    if (!cell.h.allFinite() || !(cell.h.determinant() > 0.0)) bad("periodic cell matrix singular or non-finite");
+  } else {
+    for (int a = 0; a < 3; ++a)
+      if (!(box.length(a) > 0.0) || !std::isfinite(box.length(a))) bad("wall box with a non-positive length");
+  }
+  if (!(dt > 0.0) || !std::isfinite(dt)) bad("time step not positive");
+  if (!(broadPhase.skin > 0.0) || !std::isfinite(broadPhase.skin)) bad("neighbour skin not positive");
+  if (!broadPhase.positionsAtBuild().empty()) sameSize(broadPhase.positionsAtBuild(), n, "build positions");
+  contacts.forEach([&](const auto& list) {
+    using Kind = typename std::decay_t<decltype(list)>::KindType;
+    const std::size_t m = list.size();
+    if (list.b.size() != m || list.shift.size() != m || list.history.size() != m || list.force.size() != m ||
+        list.torqueA.size() != m || (!Kind::kPlane && list.torqueB.size() != m))
+      bad(fmt::format("{} contact arrays of unequal length", Kind::kName));
+    for (std::size_t c = 0; c < m; ++c) {
+      if (list.a[c] >= n) bad(fmt::format("{} contact {}: particle index out of range", Kind::kName, c));
+      if (Kind::kPlane ? list.b[c] >= 6 : (list.b[c] >= n || list.b[c] <= list.a[c]))
+        bad(fmt::format("{} contact {}: second body out of range", Kind::kName, c));
+      if (c > 0 && !(list.key(c - 1) < list.key(c))) bad(fmt::format("{} contacts not sorted", Kind::kName));
+      const auto& h = list.history[c];
+      if (!finite(h.shearForce) || !finite(h.moment) || !finite(h.prevNormal) || !finite(list.force[c]))
+        bad(fmt::format("{} contact {}: non-finite history", Kind::kName, c));
+    }
+  });
+}
+
+}  // namespace grainlab

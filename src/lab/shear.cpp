@@ -1,0 +1,295 @@
+// The shearing tests (LAB.md tests 3–5), in a wall box or a periodic cell: drained triaxial
+// compression (lateral stresses held at p, axial strain rate imposed), compression at constant mean
+// stress ([O]: the lateral stresses follow (3p - sigma1)/2), true triaxial at constant p and b, and
+// simple shear at constant normal stress (cell only).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "lab/macro.hpp"
+#include "lab/measurements.hpp"
+#include "lab/protocols.hpp"
+
+namespace grainlab::lab {
+
+namespace {
+
+// Lateral stress targets (x = sigma2, y = sigma3) of a stress path, given the axial stress sigma1.
+Vec3 lateralTargets(const TestConfig& t, double sigma1) {
+  const double p = t.confiningPressure;
+  if (t.type == "constant-p") {
+    const double lateral = 0.5 * (3.0 * p - sigma1);
+    return {lateral, lateral, 0.0};
+  }
+  if (t.type == "true-triaxial") {
+    // p = (s1 + s2 + s3)/3 and b = (s2 - s3)/(s1 - s3) held: s3 = (3p - (1 + b) s1)/(2 - b).
+    const double s3 = (3.0 * p - (1.0 + t.b) * sigma1) / (2.0 - t.b);
+    return {s3 + t.b * (sigma1 - s3), s3, 0.0};
+  }
+  return {p, p, 0.0};
+}
+
+bool simpleShear(const TestConfig& t) { return t.type == "simple-shear"; }
+
+}  // namespace
+
+double Laboratory::testStrain() const {
+  if (simpleShear(config_.test)) return sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
+  return (shear_.h0 - sampleLengths(sim_)[2]) / shear_.h0;
+}
+
+double Laboratory::finalStrain() const {
+  return simpleShear(config_.test) ? config_.test.finalShearStrain : config_.test.finalAxialStrain;
+}
+
+Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const {
+  Record r;
+  r.step = sim_.stepCount;
+  r.time = sim_.time;
+  const Vec3 len = sampleLengths(sim_);
+  const double h0 = shear_.started ? shear_.h0 : len[2];
+  const double v0 = shear_.started ? shear_.v0 : sim_.volume();
+  const Vec3 l0 = shear_.started ? shear_.l0 : len;
+  r.eps1 = (h0 - len[2]) / h0;
+  r.eps2 = (l0[0] - len[0]) / l0[0];
+  r.eps3 = (l0[1] - len[1]) / l0[1];
+  r.epsV = (v0 - sim_.volume()) / v0;
+  const Vec3 s = meanStress ? *meanStress : boundaryStress(sim_);
+  r.sigma1 = s[2];
+  r.sigma2 = s[0];
+  r.sigma3 = s[1];
+  const double lateral = 0.5 * (r.sigma2 + r.sigma3);
+  r.q = r.sigma1 - lateral;
+  r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3.0;
+  r.e = voidRatio(sim_);
+  const TestConfig& t = config_.test;
+  if (t.type == "true-triaxial") {
+    r.phiDeg = mobilisedFrictionDeg(r.sigma1, r.sigma3);
+    r.b = std::abs(r.sigma1 - r.sigma3) > 1e-9 * r.p ? (r.sigma2 - r.sigma3) / (r.sigma1 - r.sigma3)
+                                                      : std::numeric_limits<double>::quiet_NaN();
+  } else {
+    r.phiDeg = mobilisedFrictionDeg(r.sigma1, lateral);
+  }
+  r.coordination = coordinationNumber(sim_);
+  r.unbalanced = unbalancedForceRatio(sim_);
+  r.inertialNumber =
+      shear_.result.strainRate * d50_ * std::sqrt(config_.sample.density / std::max(r.p, 1e-300));
+  const Mat3 sc = contactStress(sim_);
+  r.sigma1Contact = sc(2, 2);
+  r.sigma2Contact = sc(0, 0);
+  r.sigma3Contact = sc(1, 1);
+  if (sim_.boundary == Boundary::Periodic) {
+    r.eps1Log = -std::log(len[2] / h0);
+    r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);
+    r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
+    r.tau = meanStress ? meanShearStress : 0.5 * (sc(0, 2) + sc(2, 0));
+    if (simpleShear(t)) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
+  }
+  const GrainKinematics k = currentKinematics();
+  r.rotationMeanDeg = k.rotationMeanDeg;
+  r.rotationBandMeanDeg = k.rotationBandMeanDeg;
+  r.bandFraction = k.bandFraction;
+  r.kinetic = kineticEnergy(sim_);
+  r.elastic = elasticEnergy(sim_);
+  r.workBoundary = sim_.energy.boundaryWork;
+  r.dissipSlip = sim_.energy.slip;
+  r.dissipRoll = sim_.energy.rolling;
+  r.dissipDamping = sim_.energy.damping;
+  return r;
+}
+
+void Laboratory::configureShearBoundary() {
+  const TestConfig& t = config_.test;
+  const double p = t.confiningPressure;
+  if (sim_.boundary == Boundary::Periodic) {
+    PeriodicCell& cell = sim_.cell;
+    cell.referenceLength = cell.h.diagonal();
+    cell.servoIntegral.setZero();
+    // The cell keeps its shape in shear (principal axes fixed; simple shear adds its own L_xz).
+    cell.shearControl = {CellControl::StrainRate, CellControl::StrainRate, CellControl::StrainRate};
+    if (simpleShear(t)) {
+      // Constant normal stress on z; no lateral strain (the cell's x and y edges keep their length).
+      cell.control = {CellControl::StrainRate, CellControl::StrainRate, CellControl::Stress};
+      cell.strainRate.setZero();
+      cell.targetStress = Vec3(0.0, 0.0, p);
+    } else {
+      cell.control = {CellControl::Stress, CellControl::Stress, CellControl::StrainRate};
+      cell.strainRate.setZero();
+      cell.targetStress = Vec3(p, p, 0.0);
+    }
+    return;
+  }
+  WallBox& box = sim_.box;
+  for (int a = 0; a < 2; ++a)
+    for (int side = 0; side < 2; ++side) {
+      Wall& w = box.walls[WallBox::index(a, side)];
+      w.control = WallControl::Stress;
+      w.targetStress = p;
+    }
+  box.lower(2).control = WallControl::Velocity;
+  box.upper(2).control = WallControl::Velocity;
+}
+
+void Laboratory::driveBoundary(double ramp) {
+  const TestConfig& t = config_.test;
+  ShearState& st = shear_;
+  if (sim_.boundary == Boundary::Periodic) {
+    if (simpleShear(t)) sim_.cell.shearRate = ramp * st.loadingSpeed;
+    else sim_.cell.strainRate[2] = ramp * st.loadingSpeed;
+  } else {
+    sim_.box.lower(2).velocity = ramp * st.loadingSpeed;
+    sim_.box.upper(2).velocity = -ramp * st.loadingSpeed;
+  }
+  if (t.type == "constant-p" || t.type == "true-triaxial") {
+    // The stress path: lateral targets follow the axial stress of the previous step.
+    const Vec3 target = lateralTargets(t, boundaryStress(sim_)[2]);
+    if (sim_.boundary == Boundary::Periodic) {
+      sim_.cell.targetStress[0] = target[0];
+      sim_.cell.targetStress[1] = target[1];
+    } else {
+      for (int side = 0; side < 2; ++side) {
+        sim_.box.walls[WallBox::index(0, side)].targetStress = target[0];
+        sim_.box.walls[WallBox::index(1, side)].targetStress = target[1];
+      }
+    }
+  }
+}
+
+void Laboratory::beginShear() {
+  ShearState& st = shear_;
+  st = ShearState{};
+  const TestConfig& t = config_.test;
+  const double p = t.confiningPressure;
+  const double rho = config_.sample.density;
+  setFriction(config_.contact.frictionDeg);
+  // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3, aimed at
+  // kAutoInertialNumber (2 % below the limit) so that the servo's small dips of p stay under it.
+  const std::optional<double> given = simpleShear(t) ? t.shearStrainRate : t.axialStrainRate;
+  st.result.strainRate = given.value_or(kAutoInertialNumber / (d50_ * std::sqrt(rho / p)));
+  st.result.inertialNumber = st.result.strainRate * d50_ * std::sqrt(rho / p);
+
+  const Vec3 len = sampleLengths(sim_);
+  st.h0 = len[2];
+  st.v0 = sim_.volume();
+  st.l0 = len;
+  configureShearBoundary();
+  // Walls: platens at constant speed, the engineering axial strain rate on the initial height. Cell:
+  // the same engineering rate of H_zz (or the shear rate). The rate is ramped up linearly over
+  // kPlatenRampIntegralTimes servo integral times, so that the lateral servos learn how fast their
+  // boundaries must move instead of lagging behind a sudden start (with the stiff contacts of [W]
+  // sigma1 rises by several times p within 0.05 % of axial strain).
+  st.loadingSpeed = sim_.boundary == Boundary::Periodic ? st.result.strainRate : 0.5 * st.result.strainRate * st.h0;
+  st.rampSteps = std::max(1L, static_cast<long>(kPlatenRampIntegralTimes * config_.solver.servoIntegralSteps));
+  st.started = true;
+  records_.reset(sim_);
+  sim_.energy = EnergyLedger{};
+
+  st.result.records.push_back(measure());
+  // Records are ten times denser below 1 % strain, where the moduli are measured.
+  const double every = config_.output.recordEveryStrain;
+  st.nextRecord = std::min(every, 0.1 * every);
+  st.nextSnapshot = snapshotEvery_;
+  st.nextCheckpoint = checkpointEvery_;
+  st.startStep = sim_.stepCount;
+  if (snapshot_) snapshot_(sim_, 0.0);
+}
+
+void Laboratory::buildShearPipeline(Pipeline& pipeline) {
+  ShearState& st = shear_;
+  const TestConfig& t = config_.test;
+  const double p = t.confiningPressure;
+  const double final = finalStrain();
+  const double every = config_.output.recordEveryStrain;
+  const std::string phase = t.type == "triaxial" ? std::string("triaxial shearing") : t.type;
+  auto strain = std::make_shared<double>(0.0);
+  auto last = std::make_shared<bool>(false);
+
+  pipeline.addBefore("loading drive", [this, &st] {
+    driveBoundary(std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps));
+  });
+  pipeline.addAfter("rotation record", [this] { records_.accumulateRotation(sim_.particles, sim_.dt); });
+  pipeline.addAfter("load cell", [this, &st, strain, last, final] {
+    const Mat3 sc = sim_.boundary == Boundary::Periodic ? sim_.cell.stress : Mat3::Zero();
+    st.stressSum += boundaryStress(sim_);
+    st.shearStressSum += 0.5 * (sc(0, 2) + sc(2, 0));
+    const auto walls = singleWallStresses(sim_);
+    for (int k = 0; k < 6; ++k) st.wallStressSum[k] += walls[k];
+    ++st.stressSamples;
+    *strain = testStrain();
+    *last = *strain >= final;
+  });
+  pipeline.addAfter("record", [this, &st, strain, last, every, p] {
+    if (!(*strain >= st.nextRecord || *last)) return;
+    const double samples = static_cast<double>(st.stressSamples);
+    const Vec3 meanStress = st.stressSum / samples;
+    Record r = measure(&meanStress, st.shearStressSum / samples);
+    // How well the boundary held its lateral targets, as a fraction of p: the mean of the two
+    // opposite walls (what the stresses report) and the worst single wall.
+    const Vec3 target = lateralTargets(config_.test, r.sigma1);
+    if (!simpleShear(config_.test)) {
+      st.result.maxLateralDeviation = std::max(
+          {st.result.maxLateralDeviation, std::abs(r.sigma2 - target[0]) / p, std::abs(r.sigma3 - target[1]) / p});
+      if (sim_.boundary == Boundary::Walls)
+        for (int side = 0; side < 2; ++side)
+          for (int a = 0; a < 2; ++a)
+            st.result.maxSingleWallDeviation =
+                std::max(st.result.maxSingleWallDeviation,
+                         std::abs(st.wallStressSum[WallBox::index(a, side)] / samples - target[a]) / p);
+    }
+    st.stressSum.setZero();
+    st.shearStressSum = 0.0;
+    st.wallStressSum.fill(0.0);
+    st.stressSamples = 0;
+    st.result.records.push_back(r);
+    while (st.nextRecord <= *strain) st.nextRecord += *strain < 0.01 ? 0.1 * every : every;
+  });
+  pipeline.addAfter("snapshot", [this, &st, strain, last] {
+    if (!(snapshot_ && snapshotEvery_ > 0.0 && (*strain >= st.nextSnapshot || *last))) return;
+    snapshot_(sim_, *strain);
+    while (st.nextSnapshot <= *strain) st.nextSnapshot += snapshotEvery_;
+  });
+  pipeline.addAfter("progress", [this, &st, strain, final, phase] {
+    if (progress_ && (sim_.stepCount - st.startStep) % 2000 == 0)
+      progress_(phase, std::min(1.0, *strain / final), sim_.stepCount - st.startStep);
+  });
+  pipeline.addAfter("stop at the final strain", [&pipeline, last] {
+    if (*last) pipeline.stop();
+  });
+  // Checkpoints between steps, after the step's records and snapshots: a resumed run repeats none.
+  pipeline.addAfter("checkpoint", [this, &st, &pipeline, strain] {
+    if (pipeline.stopping() || !(checkpoint_ && checkpointEvery_ > 0.0 && *strain >= st.nextCheckpoint)) return;
+    while (st.nextCheckpoint <= *strain) st.nextCheckpoint += checkpointEvery_;
+    checkpoint_(*this);
+  });
+  pipeline.addAfter("step limit", [this, &st, &pipeline, strain, phase] {
+    if (!pipeline.stopping() && sim_.stepCount - st.startStep >= config_.solver.maxSteps)
+      throw SimulationError(fmt::format("{}: reached solver.max_steps = {} at strain {:.4f}", phase,
+                                        config_.solver.maxSteps, *strain));
+  });
+}
+
+std::vector<std::string> Laboratory::shearStageNames() {
+  Pipeline pipeline(sim_);
+  buildShearPipeline(pipeline);
+  return pipeline.names();
+}
+
+ShearResult Laboratory::continueShear() {
+  ShearState& st = shear_;
+  Pipeline pipeline(sim_);
+  buildShearPipeline(pipeline);
+  pipeline.run();
+  const std::string phase = config_.test.type == "triaxial" ? std::string("triaxial shearing") : config_.test.type;
+  if (progress_) progress_(phase, 1.0, sim_.stepCount - st.startStep);
+  st.result.steps = sim_.stepCount - st.startStep;
+  return st.result;
+}
+
+ShearResult Laboratory::shear() {
+  beginShear();
+  return continueShear();
+}
+
+}  // namespace grainlab::lab
