@@ -47,6 +47,9 @@ struct PairParams {
   double tanFriction;      // [-]
   double momentLimitArm;   // moment limit per unit |Fn| [m]
   bool twisting;           // whether the moment slot acts on twisting too
+  // YADE's variant (CohFrictPhys): bending and twisting each limited by momentLimitArm |Fn| on its
+  // own, instead of the whole moment. Only for side-by-side comparisons with YADE.
+  bool separateTwistLimit = false;
 };
 
 // How the rolling friction of a contact follows from its two grains' (model of [R]).
@@ -83,6 +86,10 @@ struct SphereContactModel {
   double beta = 0.15;    // [-] (Kozicki–Donzé)
   double eta = 1.0;      // [-] (Kozicki–Donzé)
   CombineRule combine = CombineRule::Min;  // (Linear)
+  // Kozicki–Donzé moment limit: [W]'s eta (RA+RB)/2 |Fn| on the whole moment (false), or YADE
+  // 2023's eta min(RA,RB) |Fn| on bending and on twisting separately (true), so that a comparison
+  // with YADE shows the engines' differences, not the laws'.
+  bool yadeMomentLimit = false;
 
   // muA, muB: the grains' rolling friction (Linear law only).
   PairParams pairParams(double rA, double rB, double muA = 0.0, double muB = 0.0) const {
@@ -92,6 +99,7 @@ struct SphereContactModel {
       const double rBar = rA * rB / (rA + rB);
       return {kn, ks, ks * rBar * rBar, tanFriction, combineRollingFriction(combine, muA, muB) * rBar, false};
     }
+    if (yadeMomentLimit) return {kn, ks, beta * ks * rA * rB, tanFriction, eta * std::min(rA, rB), true, true};
     return {kn, ks, beta * ks * rA * rB, tanFriction, eta * 0.5 * (rA + rB), true};
   }
   // A sphere of radius r against a rigid wall (R_B -> infinity): Kn = 2 Ec r, Ks = nu Kn. A smooth
@@ -143,9 +151,17 @@ GRAINLAB_ALWAYS_INLINE ContactResponse applyLaw(const PairParams& p, const Conta
     if (!p.twisting) dTheta = bendingPart(dTheta, k.normal);
     Vec3 carriedMoment = frame * h.moment;
     if (!p.twisting) carriedMoment = bendingPart(carriedMoment, k.normal);
-    const MomentResult m = momentElasticPlastic(carriedMoment, p.kr, dTheta, p.momentLimitArm * fn);
-    h.moment = m.moment;
-    out.rollDissipation = m.dissipation;
+    if (p.separateTwistLimit) {
+      const Vec3 twistM = k.normal * k.normal.dot(carriedMoment), twistD = k.normal * k.normal.dot(dTheta);
+      const MomentResult b = momentElasticPlastic(carriedMoment - twistM, p.kr, dTheta - twistD, p.momentLimitArm * fn);
+      const MomentResult t = momentElasticPlastic(twistM, p.kr, twistD, p.momentLimitArm * fn);
+      h.moment = b.moment + t.moment;
+      out.rollDissipation = b.dissipation + t.dissipation;
+    } else {
+      const MomentResult m = momentElasticPlastic(carriedMoment, p.kr, dTheta, p.momentLimitArm * fn);
+      h.moment = m.moment;
+      out.rollDissipation = m.dissipation;
+    }
   } else {
     h.moment.setZero();
     out.rollDissipation = 0.0;

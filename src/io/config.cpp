@@ -282,6 +282,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.contact.beta = ct.number("beta", c.contact.beta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.eta = ct.number("eta", c.contact.eta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.wallFrictionDeg = ct.number("wall_friction_deg", c.contact.wallFrictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
+  c.contact.momentLimit = ct.string("moment_limit", c.contact.momentLimit, {"mean-radius", "yade"});
   const bool linear = c.contact.model == "rolling-linear";
   const toml::node* mu = ct.raw("rolling_friction");
   const toml::node* sph = ct.raw("sphericity");
@@ -417,7 +418,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   toml::table contact{{"model", c.contact.model},       {"young", c.contact.young},
                       {"poisson", c.contact.poisson},   {"friction_deg", c.contact.frictionDeg},
                       {"beta", c.contact.beta},         {"eta", c.contact.eta},
-                      {"wall_friction_deg", c.contact.wallFrictionDeg}};
+                      {"wall_friction_deg", c.contact.wallFrictionDeg},
+                      {"moment_limit", c.contact.momentLimit}};
   if (c.contact.model == "rolling-linear") {
     if (c.contact.sphericity) {
       const auto& sc = *c.contact.sphericity;

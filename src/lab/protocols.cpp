@@ -25,6 +25,7 @@ void configureSolver(const RunConfig& c, Simulation& sim) {
                         : rule == "harmonic" ? contact::CombineRule::Harmonic
                                              : contact::CombineRule::Min;
   }
+  sim.model.yadeMomentLimit = c.contact.momentLimit == "yade";
   sim.model.tanFriction = std::tan(degToRad(c.contact.frictionDeg));
   for (Wall& w : sim.box.walls) w.tanFriction = std::tan(degToRad(c.contact.wallFrictionDeg));
   sim.localDamping = c.solver.damping;

@@ -55,6 +55,9 @@ struct ContactConfig {
   double beta = 0.15;           // rolling stiffness coefficient [-]
   double eta = 1.0;             // moment limit coefficient [-]
   double wallFrictionDeg = 0.0; // 0: smooth walls, as in [W]
+  // "mean-radius": [W]'s |M| <= eta (RA+RB)/2 |Fn|; "yade": YADE's eta min(RA,RB) |Fn| on bending and
+  // twisting separately (for comparisons with YADE).
+  std::string momentLimit = "mean-radius";
   // rolling-linear only: a uniform rolling friction, or per-grain values from sphericity.
   double rollingFriction = 0.1;
   std::optional<SphericityConfig> sphericity;
