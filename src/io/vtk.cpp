@@ -6,79 +6,10 @@
 #include <cstdint>
 
 #include "io/results.hpp"
+#include "io/vtu_piece.hpp"
 #include "lab/measurements.hpp"
 
 namespace grainlab::io {
-
-namespace {
-
-// Accumulates the arrays of one VTK XML unstructured-grid piece (ASCII, readable by ParaView,
-// VTK and meshio).
-class VtuPiece {
- public:
-  void points(const std::vector<Vec3>& p) { points_ = p; }
-  void cell(const std::vector<std::int64_t>& nodes, std::uint8_t vtkType) {
-    for (auto n : nodes) connectivity_.push_back(n);
-    offsets_.push_back(static_cast<std::int64_t>(connectivity_.size()));
-    types_.push_back(vtkType);
-  }
-  void pointScalar(const std::string& name, const std::vector<double>& v) { pointData_ += array(name, v, 1); }
-  void pointVector(const std::string& name, const std::vector<Vec3>& v) { pointData_ += array(name, flatten(v), 3); }
-  void cellScalar(const std::string& name, const std::vector<double>& v) { cellData_ += array(name, v, 1); }
-  void cellVector(const std::string& name, const std::vector<Vec3>& v) { cellData_ += array(name, flatten(v), 3); }
-
-  std::string text() const {
-    std::string s = "<?xml version=\"1.0\"?>\n"
-                    "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                    "<UnstructuredGrid>\n";
-    s += fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", points_.size(), types_.size());
-    s += "<PointData>\n" + pointData_ + "</PointData>\n<CellData>\n" + cellData_ + "</CellData>\n";
-    s += array("Points", flatten(points_), 3, "<Points>\n", "</Points>\n");
-    s += "<Cells>\n";
-    s += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n" + join(connectivity_) + "</DataArray>\n";
-    s += "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n" + join(offsets_) + "</DataArray>\n";
-    std::vector<std::int64_t> types(types_.begin(), types_.end());
-    s += "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n" + join(types) + "</DataArray>\n";
-    s += "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    return s;
-  }
-
- private:
-  static std::vector<double> flatten(const std::vector<Vec3>& v) {
-    std::vector<double> out;
-    out.reserve(3 * v.size());
-    for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
-    return out;
-  }
-  static std::string join(const std::vector<std::int64_t>& v) {
-    std::string s;
-    for (auto x : v) s += fmt::format("{} ", x);
-    return s + "\n";
-  }
-  static std::string array(const std::string& name, const std::vector<double>& v, int components,
-                           const std::string& open = "", const std::string& close = "") {
-    std::string s = open + fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
-                                       name, components);
-    for (std::size_t i = 0; i < v.size(); ++i) s += fmt::format("{:.9g}{}", v[i], (i + 1) % components ? " " : "\n");
-    return s + "</DataArray>\n" + close;
-  }
-
-  std::vector<Vec3> points_;
-  std::vector<std::int64_t> connectivity_, offsets_;
-  std::vector<std::uint8_t> types_;
-  std::string pointData_, cellData_;
-};
-
-constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9;
-
-std::string pvd(const std::string& kind, const std::vector<double>& labels) {
-  std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (std::size_t i = 0; i < labels.size(); ++i)
-    s += fmt::format("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}_{:04d}.vtu\"/>\n", labels[i], kind, i);
-  return s + "</Collection>\n</VTKFile>\n";
-}
-
-}  // namespace
 
 std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   const Particles& P = sim.particles;
@@ -91,7 +22,7 @@ std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   }
   VtuPiece v;
   v.points(P.position);
-  for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, kVertex);
+  for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, VtuPiece::kVertex);
   v.pointScalar("radius", P.radius);
   v.pointVector("velocity", P.velocity);
   v.pointVector("angular_velocity", P.angularVelocity);
@@ -116,7 +47,7 @@ std::string contactsVtu(const Simulation& sim) {
     const std::uint32_t a = nl.pairA[p], b = nl.pairB[p];
     const Vec3 n = (sim.particles.position[b] - sim.particles.position[a]).normalized();
     const Vec3& f = sim.pairForce[p];
-    v.cell({a, b}, kLine);
+    v.cell({a, b}, VtuPiece::kLine);
     fn.push_back(f.dot(n));
     ft.push_back((f - f.dot(n) * n).norm());
     force.push_back(f);
@@ -145,7 +76,7 @@ std::string wallsVtu(const Simulation& sim) {
     const std::array<int, 4> order{0, 1 << b, (1 << b) | (1 << c), 1 << c};
     std::vector<std::int64_t> quad;
     for (int o : order) quad.push_back(o | bit);
-    v.cell(quad, kQuad);
+    v.cell(quad, VtuPiece::kQuad);
     stress.push_back(box.wallStress(static_cast<int>(&w - box.walls.data())));
     force.push_back(w.normalForce);
     normals.push_back(w.inwardNormal());
@@ -163,7 +94,7 @@ void VtkSeries::write(const Simulation& sim, double label, const PointFields& ex
   writeFileAtomic(dir_ / fmt::format("walls_{:04d}.vtu", index), wallsVtu(sim));
   labels_.push_back(label);
   for (const char* kind : {"particles", "contacts", "walls"})
-    writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvd(kind, labels_));
+    writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvdCollection(kind, labels_));
 }
 
 }  // namespace grainlab::io
