@@ -100,6 +100,15 @@ Vec3 OrientationClasses::direction(int face, double alpha, double beta) {
 }
 
 std::size_t OrientationClasses::classOf(const Vec3& n) const {
+  // Directions whose first non-zero component is negative are classified as the mirror image of
+  // −n: the class of −n is then exactly the mirror of the class of n, even for a direction on a
+  // patch boundary (where the tie-break below is one-sided).
+  const int lead = n[0] != 0.0 ? 0 : (n[1] != 0.0 ? 1 : 2);
+  if (n[lead] < 0.0) return mirror(classOfCanonical(-n));
+  return classOfCanonical(n);
+}
+
+std::size_t OrientationClasses::classOfCanonical(const Vec3& n) const {
   int a = 0;
   for (int i = 1; i < 3; ++i)
     if (std::abs(n[i]) > std::abs(n[a])) a = i;
@@ -113,6 +122,13 @@ std::size_t OrientationClasses::classOf(const Vec3& n) const {
   };
   const int i = cell(n[(a + 1) % 3]), j = cell(n[(a + 2) % 3]);
   return static_cast<std::size_t>((face * cells + i) * cells + j);
+}
+
+std::size_t OrientationClasses::mirror(std::size_t k) const {
+  const Patch p = patch(k);
+  const int cells = 2 * divisions_;
+  const int face = p.face ^ 1;  // same axis, opposite sign
+  return static_cast<std::size_t>((face * cells + (cells - 1 - p.i)) * cells + (cells - 1 - p.j));
 }
 
 std::array<Vec3, 4> OrientationClasses::corners(std::size_t k) const {

@@ -29,9 +29,9 @@ class OrientationClasses {
   int divisions() const { return divisions_; }
   std::size_t size() const { return area_.size(); }
 
-  // The class holding direction n (need not be normalised; must be non-zero). Points on a patch
-  // boundary go to the patch with the larger index along each face coordinate, except on the
-  // outer edge of a face; a cube edge or corner goes to the face of the first largest |n_i|.
+  // The class holding direction n (need not be normalised; must be non-zero). A direction on a
+  // patch boundary goes to one of its patches, chosen so that classOf(−n) is always the mirror
+  // image of classOf(n) (central symmetry holds for every direction, not only almost all).
   std::size_t classOf(const Vec3& n) const;
 
   // Solid angle [sr] of class k, from the closed form of a gnomonic rectangle (sum over all = 4π).
@@ -58,6 +58,11 @@ class OrientationClasses {
     int i, j;          // angle cells along the face's two coordinates, 0..2N−1
   };
   Patch patch(std::size_t k) const;
+  // classOf for a direction whose first non-zero component is positive: points on a patch
+  // boundary go to the patch with the larger cell index (clamped at the face's outer edge); a
+  // cube edge or corner goes to the face of the first largest |n_i|.
+  std::size_t classOfCanonical(const Vec3& n) const;
+  std::size_t mirror(std::size_t k) const;  // the class of the mirror patch (−n)
   // Direction of the face point with angles (alpha, beta) on `face`.
   static Vec3 direction(int face, double alpha, double beta);
 

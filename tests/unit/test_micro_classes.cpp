@@ -116,6 +116,17 @@ TEST(OrientationClasses, CentrallySymmetric) {
     EXPECT_NEAR(oc.area(m), oc.area(k), 1e-15);
     EXPECT_LT((oc.centre(m) + oc.centre(k)).norm(), 1e-14);
   }
+  // Also for directions on patch boundaries, edges and corners of the cube (lattice normals).
+  std::vector<Vec3> special;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x || y || z) special.emplace_back(x, y, z);
+  for (const Vec3& n : special) {
+    const std::size_t k = oc.classOf(n), m = oc.classOf(-n);
+    EXPECT_NE(k, m);
+    EXPECT_LT((oc.centre(m) + oc.centre(k)).norm(), 1e-14) << n.transpose();
+  }
 }
 
 TEST(OrientationClasses, UniformDirectionsFillClassesInProportionToArea) {
