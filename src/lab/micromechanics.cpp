@@ -396,8 +396,7 @@ MicroAnalysis MicroAnalyzer::analyse(const MicroNetwork& net) const {
   if (!(net.volume > 0.0) || !std::isfinite(net.volume))
     throw std::invalid_argument("micromechanics: the volume must be positive");
   MicroAnalysis m;
-  m.coordination = coordination(net);
-  const auto index = indexById(net);
+  m.coordination = coordination(net);  // also validates the ids
   const OrientationClasses& oc = classes_;
   const std::size_t nk = oc.size();
   const int axis = options_.axialAxis;
