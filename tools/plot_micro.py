@@ -97,8 +97,12 @@ def planar_rose(ax_count, ax_force, normals, fn, snapshot, plane):
     phi = np.linspace(0.0, 2 * math.pi, 361)
     d = np.zeros((phi.size, 3))
     d[:, h], d[:, v] = np.cos(phi), np.sin(phi)
+    # A strongly anisotropic second-order expansion can dip below zero; a polar axis would draw a
+    # negative radius on the opposite side, so the fits are drawn clipped at zero.
     e_fit = fitted(snapshot, "a_r", 1.0 / (4 * math.pi), d)
     f_fit = fitted(snapshot, "a_n", snapshot.get("f0"), d)
+    e_fit = None if e_fit is None else np.maximum(e_fit, 0.0)
+    f_fit = None if f_fit is None else np.maximum(f_fit, 0.0)
     if e_fit is not None:
         ax_count.plot(phi, e_fit, "k-", lw=1.3, label="(1 + a^r:nn)/4pi")
         ax_count.plot(phi, np.full_like(phi, 1.0 / (4 * math.pi)), "k:", lw=0.8, label="isotropic")

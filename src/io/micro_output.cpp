@@ -62,6 +62,7 @@ json tensor4(const std::optional<lab::Tensor4>& t) {
 std::optional<double> meanStress(const std::optional<Mat3>& s) {
   return s ? std::optional<double>(s->trace() / 3.0) : std::nullopt;
 }
+std::optional<double> meanStress(const Mat3& s) { return s.trace() / 3.0; }
 
 }  // namespace
 
@@ -124,7 +125,7 @@ std::string orientationClassesVtu(const lab::OrientationClasses& oc, const lab::
 std::string microAnalysisCsv(const std::vector<AnalysedSnapshot>& rows, const lab::MicroColumnSet& set) {
   std::string s =
       "index,step,eps1,Z,particles,contacts,wall_contacts,rattlers,empty_classes,q_over_p,q_over_p_contacts,"
-      "p,p_contacts,p_sff,sff_error_measured";
+      "q_over_p_particle_contacts,p,p_contacts,p_particle_contacts,p_sff,sff_error_measured";
   for (const auto& name : lab::microColumnNames(set)) {
     s += ',';
     s += name;
@@ -134,9 +135,9 @@ std::string microAnalysisCsv(const std::vector<AnalysedSnapshot>& rows, const la
     const auto& c = m.coordination;
     s += fmt::format("{},{},{:.10g},{:.10g},{},{},{},{},{}", info.index, info.step, info.eps1, c.Z, c.particles,
                      c.particleContacts, c.wallContacts, c.rattlers, m.emptyClasses);
-    for (const auto& v : {m.qOverPMeasured, m.qOverPContacts, meanStress(m.stressMeasured),
-                          std::optional<double>(m.stressAllContacts.trace() / 3.0), meanStress(m.stressSff),
-                          m.sffErrorMeasured})
+    for (const auto& v : {m.qOverPMeasured, m.qOverPContacts, m.qOverPParticleContacts, meanStress(m.stressMeasured),
+                          meanStress(m.stressAllContacts), meanStress(m.stressParticleContacts),
+                          meanStress(m.stressSff), m.sffErrorMeasured})
       appendField(s, v);
     for (const auto& v : lab::microRowValues(m, set)) appendField(s, v);
     s += '\n';
@@ -180,6 +181,7 @@ json microAnalysisJson(const AnalysedSnapshot& s) {
       {"stress_sff_linear", optionalMatrix(m.stressSffLinear)},
       {"q_over_p", optionalNumber(m.qOverPMeasured)},
       {"q_over_p_contacts", optionalNumber(m.qOverPContacts)},
+      {"q_over_p_particle_contacts", optionalNumber(m.qOverPParticleContacts)},
       {"q_over_p_sff", optionalNumber(m.qOverPSff)},
       {"q_over_p_sff_linear", optionalNumber(m.qOverPSffLinear)},
       {"sff_error", optionalNumber(m.sffError)},

@@ -447,6 +447,7 @@ MicroAnalysis MicroAnalyzer::analyse(const MicroNetwork& net) const {
   if (ellipsoids > 0) m.aE = anisotropyOf(7.5 * deviator(orientation / static_cast<double>(ellipsoids)), reference);
   if (net.measuredStress) m.qOverPMeasured = qOverP(*net.measuredStress, axis);
   m.qOverPContacts = qOverP(m.stressAllContacts, axis);
+  m.qOverPParticleContacts = qOverP(m.stressParticleContacts, axis);
 
   ClassAverages& ca = m.classes;
   ca.count = count;

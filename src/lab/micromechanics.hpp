@@ -98,7 +98,7 @@ struct MicroAnalysis {
   std::optional<Mat3> stressSffLinear;  // first order in the anisotropies
   std::optional<Mat3> stressSff;        // the whole product of the truncated densities
   // q/p with q = σ_aa − (σ_bb + σ_cc)/2 along MicroOptions::axialAxis, p = tr σ / 3.
-  std::optional<double> qOverPMeasured, qOverPContacts, qOverPSff, qOverPSffLinear;
+  std::optional<double> qOverPMeasured, qOverPContacts, qOverPParticleContacts, qOverPSff, qOverPSffLinear;
   // ‖σ_sff − σ_pp‖ / ‖σ_pp‖ (Frobenius, σ_pp over the same contacts) and the same against the
   // measured stress.
   std::optional<double> sffError, sffErrorMeasured;
