@@ -117,7 +117,7 @@ SpherePolynomial scalarExpansion(const Mat3& a, const std::optional<Tensor4>& a4
   return p;
 }
 
-// Component i of the unit-magnitude vector field g(n)·n + t·n − (t:nn)·n.
+// Component i of the vector field g(n)·n + t·n − (t:nn)·n (normal part g, tangential part from t).
 SpherePolynomial vectorExpansion(int i, const SpherePolynomial& g, const Mat3& t) {
   const SpherePolynomial ni = SpherePolynomial::linear(Vec3::Unit(i));
   return g * ni + SpherePolynomial::linear(t.row(i).transpose()) - SpherePolynomial::quadratic(t) * ni;
