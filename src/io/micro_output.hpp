@@ -1,5 +1,5 @@
 #pragma once
-// Results of the micromechanical analysis (docs/micromechanics.md §7): the class averages as CSV
+// Results of the micromechanical analysis (docs/micromechanics.md §5): the class averages as CSV
 // and as a VTK grid on the unit sphere, the table of every analysed snapshot, and its JSON form.
 // A value that could not be measured is an empty CSV field, a JSON null, or NaN in VTK cell data
 // (ParaView shows it in its NaN colour).

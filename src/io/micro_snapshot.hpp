@@ -1,7 +1,7 @@
 #pragma once
 // Micromechanics snapshots: the contact network and the particles of a run at chosen instants, so
 // that `grainlab analyse DIR` can recompute the analysis later without rerunning. Plain CSV in
-// DIR/micro/ (docs/micromechanics.md §7 documents every column):
+// DIR/micro/ (docs/micromechanics.md §5 documents every column):
 //
 //   snapshots.csv        index,step,eps1,volume,sxx,syy,szz,sxy,sxz,syz    (one row per snapshot;
 //                        the measured stress, compression positive, or six empty fields)

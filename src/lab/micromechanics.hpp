@@ -124,7 +124,7 @@ class MicroAnalyzer {
 
 // Parameters of the stress–force–fabric relation: σ_ij = m_v·f0·l0·(1/4π)∫ E(n)·F̂_i(n)·L̂_j(n) dΩ
 // with 4π·E = 1 + a^r:nn (+ A^r::nnnn), F̂ = (1 + a^n:nn (+ A^n::nnnn))·n + a^t·n − (a^t:nn)·n,
-// L̂ = (1 + a^v:nn)·n + a^τ·n − (a^τ:nn)·n (docs/micromechanics.md §5).
+// L̂ = (1 + a^v:nn)·n + a^τ·n − (a^τ:nn)·n (docs/micromechanics.md §4).
 struct SffTerms {
   double mv = 0.0, f0 = 0.0, l0 = 0.0;  // contacts per volume [1/m³], [N], [m]
   Mat3 ar = Mat3::Zero(), an = Mat3::Zero(), at = Mat3::Zero(), av = Mat3::Zero(), atau = Mat3::Zero();
