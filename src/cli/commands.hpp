@@ -45,4 +45,14 @@ struct BenchOptions {
 };
 int runBench(const BenchOptions& options);
 
+struct AnalyseOptions {
+  std::string dir;
+  int classDivisions = 4;    // N: 24·N² orientation classes
+  bool fourthOrder = false;  // also the fourth-order anisotropies
+  bool plots = true;
+  bool quiet = false;
+};
+// `grainlab analyse DIR`: the micromechanics of a run recomputed from DIR/micro/ snapshots.
+int runAnalyse(const AnalyseOptions& options);
+
 }  // namespace grainlab::cli

@@ -57,6 +57,14 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--threads", bench.threads, "OpenMP threads")->capture_default_str();
   benchCmd->add_flag("--json", bench.json, "print one JSON object");
 
+  cli::AnalyseOptions analyse;
+  auto* analyseCmd = app.add_subcommand("analyse", "Micromechanics of a finished run, from its snapshots (DIR/micro)");
+  analyseCmd->add_option("dir", analyse.dir, "results folder of the run")->required();
+  analyseCmd->add_option("--classes", analyse.classDivisions, "N: 24*N^2 orientation classes")->capture_default_str();
+  analyseCmd->add_flag("--fourth-order", analyse.fourthOrder, "also the fourth-order anisotropies");
+  analyseCmd->add_flag("--no-plots", [&](std::int64_t) { analyse.plots = false; }, "skip the pictures");
+  analyseCmd->add_flag("--quiet", analyse.quiet, "no table on stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -70,6 +78,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (app.got_subcommand("bench")) return cli::runBench(bench);
+    if (app.got_subcommand("analyse")) return cli::runAnalyse(analyse);
     if (app.got_subcommand("sweep")) return cli::runSweep(sweep);
     if (app.got_subcommand("check")) return cli::checkConfig(check);
     if (app.got_subcommand("resume")) return cli::resumeLab(resume);

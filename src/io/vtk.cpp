@@ -7,79 +7,10 @@
 
 #include "io/results.hpp"
 #include "core/contact_view.hpp"
+#include "io/vtu_piece.hpp"
 #include "lab/measurements.hpp"
 
 namespace grainlab::io {
-
-namespace {
-
-// Accumulates the arrays of one VTK XML unstructured-grid piece (ASCII, readable by ParaView,
-// VTK and meshio).
-class VtuPiece {
- public:
-  void points(const std::vector<Vec3>& p) { points_ = p; }
-  void cell(const std::vector<std::int64_t>& nodes, std::uint8_t vtkType) {
-    for (auto n : nodes) connectivity_.push_back(n);
-    offsets_.push_back(static_cast<std::int64_t>(connectivity_.size()));
-    types_.push_back(vtkType);
-  }
-  void pointScalar(const std::string& name, const std::vector<double>& v) { pointData_ += array(name, v, 1); }
-  void pointVector(const std::string& name, const std::vector<Vec3>& v) { pointData_ += array(name, flatten(v), 3); }
-  void cellScalar(const std::string& name, const std::vector<double>& v) { cellData_ += array(name, v, 1); }
-  void cellVector(const std::string& name, const std::vector<Vec3>& v) { cellData_ += array(name, flatten(v), 3); }
-
-  std::string text() const {
-    std::string s = "<?xml version=\"1.0\"?>\n"
-                    "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                    "<UnstructuredGrid>\n";
-    s += fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", points_.size(), types_.size());
-    s += "<PointData>\n" + pointData_ + "</PointData>\n<CellData>\n" + cellData_ + "</CellData>\n";
-    s += array("Points", flatten(points_), 3, "<Points>\n", "</Points>\n");
-    s += "<Cells>\n";
-    s += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n" + join(connectivity_) + "</DataArray>\n";
-    s += "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n" + join(offsets_) + "</DataArray>\n";
-    std::vector<std::int64_t> types(types_.begin(), types_.end());
-    s += "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n" + join(types) + "</DataArray>\n";
-    s += "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    return s;
-  }
-
- private:
-  static std::vector<double> flatten(const std::vector<Vec3>& v) {
-    std::vector<double> out;
-    out.reserve(3 * v.size());
-    for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
-    return out;
-  }
-  static std::string join(const std::vector<std::int64_t>& v) {
-    std::string s;
-    for (auto x : v) s += fmt::format("{} ", x);
-    return s + "\n";
-  }
-  static std::string array(const std::string& name, const std::vector<double>& v, int components,
-                           const std::string& open = "", const std::string& close = "") {
-    std::string s = open + fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
-                                       name, components);
-    for (std::size_t i = 0; i < v.size(); ++i) s += fmt::format("{:.9g}{}", v[i], (i + 1) % components ? " " : "\n");
-    return s + "</DataArray>\n" + close;
-  }
-
-  std::vector<Vec3> points_;
-  std::vector<std::int64_t> connectivity_, offsets_;
-  std::vector<std::uint8_t> types_;
-  std::string pointData_, cellData_;
-};
-
-constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9, kHexahedron = 12;
-
-std::string pvd(const std::string& kind, const std::vector<double>& labels) {
-  std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (std::size_t i = 0; i < labels.size(); ++i)
-    s += fmt::format("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}_{:04d}.vtu\"/>\n", labels[i], kind, i);
-  return s + "</Collection>\n</VTKFile>\n";
-}
-
-}  // namespace
 
 std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   const Particles& P = sim.particles;
@@ -89,7 +20,7 @@ std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<double>(P.id[i]);
   VtuPiece v;
   v.points(P.position);
-  for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, kVertex);
+  for (std::size_t i = 0; i < n; ++i) v.cell({static_cast<std::int64_t>(i)}, VtuPiece::kVertex);
   v.pointScalar("id", ids);
   v.pointScalar("radius", P.radius);
   v.pointVector("velocity", P.velocity);
@@ -116,7 +47,7 @@ std::string contactsVtu(const Simulation& sim) {
       end = static_cast<std::int64_t>(points.size());
       points.push_back(image);
     }
-    v.cell({c.a, end}, kLine);
+    v.cell({c.a, end}, VtuPiece::kLine);
     fn.push_back(c.force.dot(c.normal));
     ft.push_back((c.force - c.force.dot(c.normal) * c.normal).norm());
     force.push_back(c.force);
@@ -147,7 +78,7 @@ std::string wallsVtu(const Simulation& sim) {
     const std::array<int, 4> order{0, 1 << b, (1 << b) | (1 << c), 1 << c};
     std::vector<std::int64_t> quad;
     for (int o : order) quad.push_back(o | bit);
-    v.cell(quad, kQuad);
+    v.cell(quad, VtuPiece::kQuad);
     stress.push_back(box.wallStress(static_cast<int>(&w - box.walls.data())));
     force.push_back(w.normalForce);
     normals.push_back(w.inwardNormal());
@@ -168,7 +99,7 @@ std::string cellVtu(const Simulation& sim) {
   for (const auto& c : kOrder) corners.push_back(h * Vec3(c[0], c[1], c[2]));
   VtuPiece v;
   v.points(corners);
-  v.cell({0, 1, 2, 3, 4, 5, 6, 7}, kHexahedron);
+  v.cell({0, 1, 2, 3, 4, 5, 6, 7}, VtuPiece::kHexahedron);
   const Mat3& s = sim.cell.stress;
   v.cellVector("stress_diagonal", {Vec3(s(0, 0), s(1, 1), s(2, 2))});
   v.cellVector("stress_shear_yz_xz_xy", {Vec3(0.5 * (s(1, 2) + s(2, 1)), 0.5 * (s(0, 2) + s(2, 0)), 0.5 * (s(0, 1) + s(1, 0)))});
@@ -183,7 +114,7 @@ void VtkSeries::write(const Simulation& sim, double label, const PointFields& ex
   writeFileAtomic(dir_ / fmt::format("{}_{:04d}.vtu", boundary, index), wallsVtu(sim));
   labels_.push_back(label);
   for (const char* kind : {"particles", "contacts", boundary})
-    writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvd(kind, labels_));
+    writeFileAtomic(dir_ / fmt::format("{}.pvd", kind), pvdCollection(kind, labels_));
 }
 
 }  // namespace grainlab::io
