@@ -216,7 +216,9 @@ class RunSession {
     summary_["wall_seconds"] = wall;
     summary_["particle_steps_per_s"] = static_cast<double>(steps) * config_.sample.nParticles / wall;
     summary_["status"] = "completed";
-    io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, io::timeseriesColumns(config_)));
+    io::TimeseriesColumns columns = io::timeseriesColumns(config_);
+    columns.micro = lab_.microColumnNames();
+    io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, columns));
     io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
     if (config_.output.plots) makePlots(dir_, quiet_);
     if (!quiet_) {

@@ -165,6 +165,14 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
       if (!Kernel::evaluate(ctx, list, c, g, branch)) {
         // A pair that was apart and still is keeps its zero slots, so it is skipped without a write.
         if (!h.touching && !writeAll) continue;
+        if (h.touching) {
+          // The contact opens: what its shear and moment springs still hold is released with the
+          // history (the model keeps no memory of it), so it is booked as dissipated, slip and
+          // rolling, and the energy balance stays closed.
+          const contact::PairParams p = Kernel::params(ctx, list, c);
+          if (p.ks > 0.0) slip += 0.5 * h.shearForce.squaredNorm() / p.ks;
+          if (p.kr > 0.0) roll += 0.5 * h.moment.squaredNorm() / p.kr;
+        }
         h = typename Kind::History{};
         list.force[c].setZero();
         list.torqueA[c].setZero();

@@ -25,7 +25,11 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
 }
 
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
-  return {config.test.boundary == "periodic", config.test.type == "simple-shear", config.test.type == "true-triaxial"};
+  TimeseriesColumns c;
+  c.periodic = config.test.boundary == "periodic";
+  c.simpleShear = config.test.type == "simple-shear";
+  c.trueTriaxial = config.test.type == "true-triaxial";
+  return c;
 }
 
 std::string timeseriesCsv(const std::vector<lab::Record>& records, const TimeseriesColumns& columns) {
@@ -36,6 +40,8 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   if (columns.periodic) s += ",eps1_log,stress_skew";
   if (columns.simpleShear) s += ",gamma,tau";
   if (columns.trueTriaxial) s += ",b";
+  s += ",energy_residual";
+  for (const auto& name : columns.micro) s += "," + name;
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -59,10 +65,13 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
       put(r.step, r.gamma);
       put(r.step, r.tau);
     }
-    if (columns.trueTriaxial) {
-      if (std::isnan(r.b)) s += ",";
-      else put(r.step, r.b);
-    }
+    auto nullable = [&](double v) {
+      if (std::isnan(v)) s += ",";
+      else put(r.step, v);
+    };
+    if (columns.trueTriaxial) nullable(r.b);
+    nullable(r.energyResidual);
+    for (std::size_t k = 0; k < columns.micro.size(); ++k) nullable(r.micro.at(k));
     s += '\n';
   }
   return s;

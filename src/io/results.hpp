@@ -14,12 +14,16 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
 // stress_skew), simple shear's (gamma, tau) and true triaxial's (b).
 struct TimeseriesColumns {
   bool periodic = false, simpleShear = false, trueTriaxial = false;
+  // The micromechanical columns of the records (Laboratory::microColumnNames), after
+  // energy_residual; their NaNs (not measurable) are written as empty fields.
+  std::vector<std::string> micro;
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 
 // The time series as CSV (header + one row per record). Throws SimulationError on a non-finite
-// value rather than writing it; only b, undefined while sigma1 = sigma3, is written as an empty
-// field (null) there.
+// value rather than writing it; only values that may be unmeasurable (b while sigma1 = sigma3,
+// the energy residual before any external work, micromechanics without contacts) are written as
+// empty fields (null).
 std::string timeseriesCsv(const std::vector<lab::Record>& records, const TimeseriesColumns& columns = {});
 
 }  // namespace grainlab::io

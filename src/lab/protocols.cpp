@@ -65,6 +65,7 @@ void holdIsotropicStress(Simulation& sim, double pressure) {
 Laboratory::Laboratory(const RunConfig& config, ProgressFn progress)
     : config_(config), progress_(std::move(progress)) {
   sim_.boundary = config.test.boundary == "periodic" ? Boundary::Periodic : Boundary::Walls;
+  static_assert(Record::kMicroColumns >= 11 + 2 + 6 * 3 + 2, "room for every micromechanical column");
 }
 
 EquilibriumState Laboratory::equilibriumState() const {
@@ -248,6 +249,8 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.shearStressSum);
   put(out, st.wallStressSum);
   put(out, st.stressSamples);
+  put(out, st.elastic0);
+  put(out, st.kinetic0);
   put(out, st.result.strainRate);
   put(out, st.result.inertialNumber);
   put(out, st.result.maxLateralDeviation);
@@ -275,6 +278,8 @@ void Laboratory::loadState(std::istream& in) {
   get(in, st.shearStressSum);
   get(in, st.wallStressSum);
   get(in, st.stressSamples);
+  get(in, st.elastic0);
+  get(in, st.kinetic0);
   get(in, st.result.strainRate);
   get(in, st.result.inertialNumber);
   get(in, st.result.maxLateralDeviation);

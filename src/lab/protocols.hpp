@@ -16,6 +16,7 @@
 #include "lab/grading.hpp"
 #include "lab/grain_records.hpp"
 #include "lab/kinematics.hpp"
+#include "lab/micromechanics.hpp"
 #include "lab/run_config.hpp"
 
 namespace grainlab::lab {
@@ -49,6 +50,13 @@ struct Record {
   // True triaxial: b = (sigma2 - sigma3)/(sigma1 - sigma3) of the recorded stresses (NaN while
   // sigma1 = sigma3, written as an empty field).
   double b = 0.0;
+  // Micromechanics (lab/micromechanics.hpp), the columns microColumnNames() lists, NaN where a value
+  // could not be measured (written as an empty field, null).
+  static constexpr std::size_t kMicroColumns = 40;
+  std::array<double, kMicroColumns> micro{};
+  // Energy balance ([W] §4.9, PHYSICS.md §7.6) since the start of shearing, as a fraction of the
+  // external work: (W - dE_elastic - dE_kinetic - D_slip - D_roll - D_damping) / W; NaN while W = 0.
+  double energyResidual = 0.0;
 };
 
 struct EquilibriumState {
@@ -125,6 +133,9 @@ class Laboratory {
   // A record of the current state; the boundary stresses are meanStress when given (the mean over
   // the recording interval, as a load cell reports it), else the instantaneous ones.
   Record measure(const Vec3* meanStress = nullptr, double meanShearStress = 0.0) const;
+  // The micromechanical columns of the records (names, in order).
+  std::vector<std::string> microColumnNames() const { return lab::microColumnNames(microColumns_); }
+  const MicroAnalyzer& microAnalyzer() const { return micro_; }
   // The stages of the shearing pipeline, in order (for the summary and the docs).
   std::vector<std::string> shearStageNames();
 
@@ -148,11 +159,14 @@ class Laboratory {
     double shearStressSum = 0.0;
     std::array<double, 6> wallStressSum{};
     long stressSamples = 0;
+    double elastic0 = 0.0, kinetic0 = 0.0;  // energies at the start of shearing [J]
     ShearResult result;
   };
   ShearState shear_;
   Simulation sim_;
   GrainRecords records_;
+  MicroAnalyzer micro_;
+  MicroColumnSet microColumns_;
   double d50_ = 0.0;
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();

@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "lab/macro.hpp"
 #include "lab/measurements.hpp"
+#include "lab/micro_network.hpp"
 #include "lab/protocols.hpp"
 
 namespace grainlab::lab {
@@ -97,6 +98,16 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.dissipSlip = sim_.energy.slip;
   r.dissipRoll = sim_.energy.rolling;
   r.dissipDamping = sim_.energy.damping;
+  if (shear_.started && r.workBoundary > 0.0) {
+    const double stored = (r.elastic - shear_.elastic0) + (r.kinetic - shear_.kinetic0);
+    r.energyResidual = (r.workBoundary - stored - r.dissipSlip - r.dissipRoll - r.dissipDamping) / r.workBoundary;
+  } else {
+    r.energyResidual = std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::vector<std::optional<double>> micro = microRowValues(micro_.analyse(microNetwork(sim_)), microColumns_);
+  r.micro.fill(std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t k = 0; k < micro.size() && k < r.micro.size(); ++k)
+    if (micro[k]) r.micro[k] = *micro[k];
   return r;
 }
 
@@ -185,6 +196,8 @@ void Laboratory::beginShear() {
   st.started = true;
   records_.reset(sim_);
   sim_.energy = EnergyLedger{};
+  st.elastic0 = elasticEnergy(sim_);
+  st.kinetic0 = kineticEnergy(sim_);
 
   st.result.records.push_back(measure());
   // Records are ten times denser below 1 % strain, where the moduli are measured.
