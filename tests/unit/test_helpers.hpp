@@ -1,5 +1,11 @@
 #pragma once
-// Small scenes built directly on the engine for physics tests.
+// Small scenes built directly on the engine for physics tests, and the one place where tests reach
+// below the engine's public API (the neighbour list's internals): when those change, only the
+// functions in `probe` below need adapting.
+#include <cstdint>
+#include <set>
+#include <utility>
+
 #include "core/simulation.hpp"
 
 namespace grainlab::scenes {
@@ -19,3 +25,32 @@ inline Simulation emptyScene(double halfSide = 1.0, double frictionDeg = 30.0) {
 }
 
 }  // namespace grainlab::scenes
+
+namespace grainlab::probe {
+
+// Builds the broad-phase candidate lists for the current positions now (as the next step would).
+inline void buildNeighbours(Simulation& sim) { sim.neighbors.build(sim.particles, sim.box); }
+
+// Candidate particle pairs (a < b) of the current list.
+inline std::set<std::pair<std::uint32_t, std::uint32_t>> candidatePairs(const Simulation& sim) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> out;
+  for (std::size_t p = 0; p < sim.neighbors.pairA.size(); ++p)
+    out.emplace(sim.neighbors.pairA[p], sim.neighbors.pairB[p]);
+  return out;
+}
+
+// Candidate particle-wall contacts (particle, wall index 0..5) of the current list.
+inline std::set<std::pair<std::uint32_t, int>> candidateWallContacts(const Simulation& sim) {
+  std::set<std::pair<std::uint32_t, int>> out;
+  for (std::size_t c = 0; c < sim.neighbors.wallParticle.size(); ++c)
+    out.emplace(sim.neighbors.wallParticle[c], static_cast<int>(sim.neighbors.wallIndex[c]));
+  return out;
+}
+
+// Largest displacement of a particle (or wall) the list tolerates before a rebuild is due [m].
+inline double rebuildThreshold(const Simulation& sim) { return sim.neighbors.halfSkin(); }
+
+// Number of times the list has been built.
+inline long listBuilds(const Simulation& sim) { return sim.neighbors.builds; }
+
+}  // namespace grainlab::probe
