@@ -30,7 +30,11 @@ def test_vtk_snapshots_read_back(grainlab, data_dir, tmp_path):
     radius = particles.point_data["radius"].ravel()
     assert radius.min() >= 2.0e-3 - 1e-12 and radius.max() <= 3.0e-3 + 1e-12
     assert particles.point_data["velocity"].shape == (100, 3)
-    assert particles.point_data["rotation_deg"].min() >= 0.0
+    # The angle of the composed rotation cannot exceed the path integral of |w| dt, nor 180 deg.
+    angle = particles.point_data["rotation_deg"].ravel()
+    path = particles.point_data["rotation_path_deg"].ravel()
+    assert np.all(angle <= path + 1e-6) and angle.max() <= 180.0
+    assert path.max() > 0.0
 
     contacts = meshio.read(vtk / "contacts_0002.vtu")
     lines = contacts.cells_dict["line"]
