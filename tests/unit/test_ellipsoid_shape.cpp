@@ -110,11 +110,12 @@ TEST(EllipsoidShape, ShapeMatrixSupportAndBoundingBox) {
   }
 }
 
-// The arm of a normal force about the centre (distance from the centre to a normal line) never
-// exceeds a - c and reaches it: sampled over the surface.
-TEST(EllipsoidShape, NormalForceArmBoundedByAMinusC) {
+// The torque of a unit normal force about each body axis never exceeds maxNormalForceArms
+// (b - c, a - c, a - b) and reaches it; a tangential force's arm (distance of the point from the
+// axis) never exceeds maxTangentialForceArms (b, a, a). Sampled over the surface.
+TEST(EllipsoidShape, ContactForceArmsAboutTheBodyAxes) {
   const Vec3 s(3.0, 2.0, 1.0);
-  double worst = 0.0;
+  Vec3 worstNormal = Vec3::Zero(), worstReach = Vec3::Zero();
   const int n = 600;
   for (int i = 0; i <= n; ++i) {
     const double th = kPi * i / n;
@@ -122,9 +123,15 @@ TEST(EllipsoidShape, NormalForceArmBoundedByAMinusC) {
       const double ph = kPi * j / n;
       const Vec3 y(s.x() * std::sin(th) * std::cos(ph), s.y() * std::sin(th) * std::sin(ph), s.z() * std::cos(th));
       const Vec3 normal = y.cwiseQuotient(s.cwiseProduct(s)).normalized();
-      worst = std::max(worst, y.cross(normal).norm());
+      worstNormal = worstNormal.cwiseMax(y.cross(normal).cwiseAbs());
+      for (int k = 0; k < 3; ++k) worstReach[k] = std::max(worstReach[k], (y - y[k] * Vec3::Unit(k)).norm());
     }
   }
-  EXPECT_LE(worst, maxNormalForceArm(s) * (1 + 1e-12));
-  EXPECT_GT(worst, maxNormalForceArm(s) * (1 - 1e-4));
+  const Vec3 arms = maxNormalForceArms(s), reach = maxTangentialForceArms(s);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(worstNormal[k], arms[k] * (1 + 1e-12));
+    EXPECT_GT(worstNormal[k], arms[k] * (1 - 1e-4));
+    EXPECT_LE(worstReach[k], reach[k] * (1 + 1e-12));
+    EXPECT_GT(worstReach[k], reach[k] * (1 - 1e-4));
+  }
 }
