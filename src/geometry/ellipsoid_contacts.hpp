@@ -184,14 +184,21 @@ inline Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhen
   return sol;
 }
 
-// From the solved pencil to the contact. n: unit normal (A -> B); bPW = (1 - lambda) X_A p, the
-// Perram–Wertheim point relative to x_A; ha, hb: support distances along n (h = sqrt(n^T X n)).
+// From the solved pencil to the contact. p = G^-1 R at the maximiser (any frame), n: the unit
+// normal (A -> B) in world coordinates, bPW = (1 - lambda) X_A p: the Perram–Wertheim point
+// relative to x_A, in world coordinates. At the maximiser (1 - lambda)^2 p.X_A p = lambda^2 p.X_B p
+// = F (S' = 0), so the PW point lies on both bodies scaled by sqrt F, with normal n, and the
+// support distances along n come without another quadratic form:
+//     h_A = sqrt(n.X_A n) = sqrt(F)/((1 - lambda)|p|),   h_B = sqrt(F)/(lambda |p|).
 // The force line is n through the PW point; the contact point is moved along that line (which
 // changes no torque of the normal force) to midway between the two support planes, where the
 // sphere kernel puts it: n.(C - x_A) = (h_A - h_B + n.R)/2.
-inline void assemble(EllipsoidContact& c, const Vec3& r, const Vec3& n, const Vec3& bPW, double ha,
-                     double hb, double potentialLength) {
-  const double gap = 1.0 - std::sqrt(c.contactFunction);  // > 0: overlapping
+inline void assemble(EllipsoidContact& c, const Vec3& r, const Vec3& p, const Vec3& n, const Vec3& bPW,
+                     double potentialLength) {
+  const double sqrtF = std::sqrt(c.contactFunction);
+  const double scale = sqrtF / p.norm();
+  const double ha = scale / (1.0 - c.lambda), hb = scale / c.lambda;
+  const double gap = 1.0 - sqrtF;  // > 0: overlapping
   const double h = ha + hb;
   const double l = potentialLength > 0.0 ? potentialLength : h;
   c.touching = true;
@@ -210,10 +217,19 @@ inline void assemble(EllipsoidContact& c, const Vec3& r, const Vec3& n, const Ve
 // along world z rather than NaN (the engine should never get there; a sane time step forbids it).
 inline EllipsoidContact coincidentCentres(double ha, double hb, double potentialLength) {
   EllipsoidContact c;
-  c.contactFunction = 0.0;
-  c.lambda = 0.5;
+  const double h = ha + hb;
+  const double l = potentialLength > 0.0 ? potentialLength : h;
+  c.touching = true;
   c.converged = true;
-  assemble(c, Vec3::Zero(), Vec3::UnitZ(), Vec3::Zero(), ha, hb, potentialLength);
+  c.lambda = ha / h;
+  c.supportSum = h;
+  c.depth = h;
+  c.potentialLength = l;
+  c.geometry.normal = Vec3::UnitZ();
+  c.geometry.overlap = l * l / h;
+  c.energyOverKn = 0.5 * l * l;
+  c.geometry.branchA = 0.5 * (ha - hb) * Vec3::UnitZ();
+  c.geometry.branchB = c.geometry.branchA;
   return c;
 }
 
@@ -238,9 +254,7 @@ inline EllipsoidContact ellipsoidEllipsoid(const Vec3& branch, const Sym3& xa, c
   c.iterations = s.iterations;
   c.converged = s.converged;
   if (s.apart || !(s.contactFunction < 1.0)) return c;
-  const Vec3 n = s.p.normalized();
-  pw::assemble(c, branch, n, (1.0 - s.lambda) * (xa * s.p), std::sqrt(xa.quadratic(n)),
-               std::sqrt(xb.quadratic(n)), potentialLength);
+  pw::assemble(c, branch, s.p, s.p.normalized(), (1.0 - s.lambda) * (xa * s.p), potentialLength);
   return c;
 }
 
@@ -249,7 +263,9 @@ inline EllipsoidContact ellipsoidEllipsoid(const Vec3& branch, const Sym3& xa, c
 // results agree with ellipsoidEllipsoid(branch, ra^2 I, X_B, ...) to round-off).
 inline EllipsoidContact sphereEllipsoid(const Vec3& branch, double ra, const Vec3& semiAxesB,
                                         const Quat& qb, double lambdaPrev, double potentialLength) {
-  if (branch.squaredNorm() == 0.0) return pw::coincidentCentres(ra, semiAxesB.z(), potentialLength);
+  if (branch.squaredNorm() == 0.0) {
+    return pw::coincidentCentres(ra, std::sqrt(shapeMatrix(semiAxesB, qb).zz), potentialLength);
+  }
   const Vec3 rBody = qb.conjugate() * branch;
   const Vec3 xa = Vec3::Constant(ra * ra);
   const Vec3 xb = semiAxesB.cwiseProduct(semiAxesB);
@@ -261,10 +277,7 @@ inline EllipsoidContact sphereEllipsoid(const Vec3& branch, double ra, const Vec
   c.iterations = s.iterations;
   c.converged = s.converged;
   if (s.apart || !(s.contactFunction < 1.0)) return c;
-  const Vec3 nBody = s.p.normalized();
-  const Vec3 n = qb * nBody;
-  const Vec3 bPW = qb * ((1.0 - s.lambda) * ra * ra * s.p);
-  pw::assemble(c, branch, n, bPW, ra, std::sqrt(xb.dot(nBody.cwiseProduct(nBody))), potentialLength);
+  pw::assemble(c, branch, s.p, qb * s.p.normalized(), qb * ((1.0 - s.lambda) * ra * ra * s.p), potentialLength);
   return c;
 }
 

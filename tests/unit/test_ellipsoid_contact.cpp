@@ -124,6 +124,18 @@ TEST(EllipsoidContact, SphereEllipsoidEqualsGeneralSolve) {
   }
 }
 
+// Coincident centres (no normal defined): a finite deep contact along z, never NaN.
+TEST(EllipsoidContact, CoincidentCentresGiveAFiniteContact) {
+  const Sym3 xa = shapeMatrix(Vec3(2, 1, 0.5), Quat::Identity()), xb = shapeMatrix(Vec3(1, 1, 1), Quat::Identity());
+  const EllipsoidContact c = ellipsoidEllipsoid(Vec3::Zero(), xa, xb, 0.0, 0.0);
+  EXPECT_TRUE(c.touching);
+  EXPECT_EQ(c.geometry.normal, Vec3::UnitZ());
+  EXPECT_DOUBLE_EQ(c.depth, 1.5);  // support distances along z: 0.5 + 1
+  EXPECT_TRUE(c.geometry.branchA.allFinite() && std::isfinite(c.geometry.overlap));
+  const EllipsoidContact s = sphereEllipsoid(Vec3::Zero(), 1.0, Vec3(2, 1, 0.5), Quat::Identity(), 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(s.depth, 1.5);
+}
+
 // Swapping A and B flips the normal, keeps overlap, depth and contact point, maps lambda to
 // 1 - lambda.
 TEST(EllipsoidContact, SwapSymmetry) {
