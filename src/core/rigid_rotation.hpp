@@ -48,12 +48,13 @@ inline Quat renormalised(Quat q) {
   return q;
 }
 
-// R(q) diag(inertia) R(q)^T v and its inverse: world-frame inertia tensor applied to v.
-inline Vec3 worldInertiaTimes(const Quat& q, const Vec3& inertia, const Vec3& v) {
-  return q * inertia.cwiseProduct(q.conjugate() * v);
+// R(q) diag(d) R(q)^T v: the world-frame inertia tensor (d = principal moments) or its inverse
+// (d = their inverses) applied to v.
+inline Vec3 worldInertiaTimes(const Quat& q, const Vec3& d, const Vec3& v) {
+  return q * d.cwiseProduct(q.conjugate() * v);
 }
 inline Vec3 worldInertiaSolve(const Quat& q, const Vec3& inertia, const Vec3& v) {
-  return q * (q.conjugate() * v).cwiseQuotient(inertia);
+  return worldInertiaTimes(q, inertia.cwiseInverse(), v);
 }
 
 // L^(n-1/2) from the stored state after a step of length dtPrev: q^n and w^(n-1/2).
@@ -80,12 +81,13 @@ constexpr int kRotationIterations = 60;
 inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMomentum, const Vec3& inertia,
                                         const Vec3& omegaGuess, double dt) {
   RotationStep out;
+  const Vec3 invInertia = inertia.cwiseInverse();
   Vec3 w = omegaGuess;
   const double tol2 = kRotationTolerance * kRotationTolerance;
   double prevChange2 = std::numeric_limits<double>::infinity();
   for (int it = 1; it <= kRotationIterations; ++it) {
     const Quat mid = rotationQuaternion(0.5 * dt * w) * q;
-    const Vec3 next = worldInertiaSolve(mid, inertia, angularMomentum);
+    const Vec3 next = worldInertiaTimes(mid, invInertia, angularMomentum);
     const double change2 = (next - w).squaredNorm();
     const double size2 = next.squaredNorm();
     w = next;

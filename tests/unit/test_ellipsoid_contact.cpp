@@ -465,7 +465,9 @@ TEST(EllipsoidContact, NoMissedContactsAgainstBruteForce) {
           EXPECT_TRUE(bounding);
           EXPECT_TRUE(axis);
         }
-        if (bounding && axis) EXPECT_EQ(ellipsoidEllipsoid(r, shape[i], shape[j], 0.0, 0.0).touching, truth);
+        if (bounding && axis) {
+          EXPECT_EQ(ellipsoidEllipsoid(r, shape[i], shape[j], 0.0, 0.0).touching, truth);
+        }
       }
     }
   }

@@ -117,7 +117,9 @@ TEST(RigidRotation, SecondOrderConvergenceOfFreeRotation) {
     freeSteps(r, dt, n);
     const double err = angleBetween(r.q, ref);
     std::cout << "[convergence] dt " << dt << " orientation error " << err << " rad\n";
-    if (k > 0) EXPECT_NEAR(prev / err, 4.0, 0.4);
+    if (k > 0) {
+      EXPECT_NEAR(prev / err, 4.0, 0.4);
+    }
     prev = err;
   }
 }
