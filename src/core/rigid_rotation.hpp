@@ -28,10 +28,21 @@ namespace grainlab::rotation {
 inline Quat rotationQuaternion(const Vec3& theta) {
   const double a2 = theta.squaredNorm();
   double c, s;  // cos(|theta|/2), sin(|theta|/2)/|theta|
-  if (a2 < 1e-2) {
+  if (a2 < 1e-6) {
+    // A DEM step (|theta| < 1e-3): three terms leave x^3/720 < 2e-20; the shorter polynomial
+    // shortens the dependency chain of the rotation fixed point.
+    constexpr double c1 = -1.0 / 2, c2 = 1.0 / 24, s1 = -1.0 / 6, s2 = 1.0 / 120;
+    const double x = 0.25 * a2;
+    c = 1.0 + x * (c1 + x * c2);
+    s = 0.5 * (1.0 + x * (s1 + x * s2));
+  } else if (a2 < 1e-2) {
+    // Taylor coefficients as constants: a division by a literal is not turned into a
+    // multiplication (it would round differently), and ten divisions per call dominated the cost.
+    constexpr double c1 = -1.0 / 2, c2 = 1.0 / 24, c3 = -1.0 / 720, c4 = 1.0 / 40320, c5 = -1.0 / 3628800;
+    constexpr double s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880, s5 = -1.0 / 39916800;
     const double x = 0.25 * a2;  // (half angle)^2
-    c = 1.0 - x / 2.0 * (1.0 - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0))));
-    s = 0.5 * (1.0 - x / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0 * (1.0 - x / 110.0)))));
+    c = 1.0 + x * (c1 + x * (c2 + x * (c3 + x * (c4 + x * c5))));
+    s = 0.5 * (1.0 + x * (s1 + x * (s2 + x * (s3 + x * (s4 + x * s5)))));
   } else {
     const double a = std::sqrt(a2);
     c = std::cos(0.5 * a);
@@ -69,21 +80,25 @@ struct RotationStep {
   bool converged = false;  // the fixed point converges for |w| dt up to ~0.5 with aspect <= 3
 };
 
-// Fixed-point iterations of the midpoint relation stop when the change of w, or the next change
-// predicted from the last two (the iteration contracts geometrically by about |w| dt (I_max/I_min
-// - 1)/2 per pass), is below this relative size. From the guess of leapfrogRotation (error
-// O(dt^2)) a DEM step (|w| dt ~ 1e-4) needs two passes.
-constexpr double kRotationTolerance = 2e-15;
+// The fixed point w = Phi(w) of the midpoint relation contracts by at most
+// kappa = |w| dt (1 + I_max/I_min)/2 per pass (Phi turns with q* by dt/2 per unit change of w), so
+// after a pass that changed w by c the remaining error is at most kappa c/(1 - kappa): the
+// iteration stops when that is below tolerance |w|. When L is rebuilt from (q, w) the fixed point
+// must hold to round-off (kRebuiltMomentumTolerance: two passes at |w| dt = 1e-4 from the guess
+// of leapfrogRotationWithMomentum, whose error is O(dt^2)); when L is stored, an error of the
+// fixed point only shifts the orientation by tolerance |w| dt per step and L stays exact, so
+// kStoredMomentumTolerance allows one pass.
+constexpr double kRebuiltMomentumTolerance = 1e-15;
+constexpr double kStoredMomentumTolerance = 1e-10;
 constexpr int kRotationIterations = 60;
 
-// Free rotation over dt with constant world angular momentum L from orientation q; omegaGuess
-// starts the fixed point.
-inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMomentum, const Vec3& inertia,
-                                        const Vec3& omegaGuess, double dt) {
+// Free rotation over dt with constant world angular momentum L from orientation q (invInertia:
+// the inverses of the principal moments); omegaGuess starts the fixed point.
+inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMomentum, const Vec3& invInertia,
+                                        const Vec3& omegaGuess, double dt, double tolerance) {
   RotationStep out;
-  const Vec3 invInertia = inertia.cwiseInverse();
   Vec3 w = omegaGuess;
-  const double tol2 = kRotationTolerance * kRotationTolerance;
+  const double anisotropy = 1.0 + invInertia.maxCoeff() / invInertia.minCoeff();
   double prevChange2 = std::numeric_limits<double>::infinity();
   for (int it = 1; it <= kRotationIterations; ++it) {
     const Quat mid = rotationQuaternion(0.5 * dt * w) * q;
@@ -92,10 +107,12 @@ inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMoment
     const double size2 = next.squaredNorm();
     w = next;
     out.iterations = it;
-    // Done when this change, or the next one extrapolated from the contraction so far, is at the
-    // tolerance; or when the change stopped shrinking at the level of a few ulp (round-off).
-    const bool small = change2 <= tol2 * size2 || (it > 1 && change2 * change2 <= tol2 * size2 * prevChange2);
-    const bool stalled = change2 >= prevChange2 && change2 <= 1e4 * tol2 * size2;
+    const double kappa = 0.5 * dt * std::sqrt(size2) * anisotropy;
+    const double bound = kappa < 0.5 ? kappa / (1.0 - kappa) : 1.0;
+    // Done when the bound on the remaining error is at the tolerance, or when the change
+    // stopped shrinking at the level of a few ulp (round-off).
+    const bool small = bound * bound * change2 <= tolerance * tolerance * size2;
+    const bool stalled = change2 >= prevChange2 && change2 <= 1e-28 * size2;
     if (small || stalled || size2 == 0.0) {
       out.converged = true;
       break;
@@ -142,11 +159,12 @@ struct LeapfrogRotation {
 
 // One rotational leapfrog step of a rigid body from q^n, w^(n-1/2), L^(n-1/2) and the torque T^n
 // to q^(n+1), w^(n+1/2), L^(n+1/2). alpha is the local damping coefficient or [O]'s alpha_R
-// [1/s], by `damping`. For an engine that stores L per particle; leapfrogRotation below
-// rebuilds it instead.
+// [1/s], by `damping`. For an engine that stores L per particle (tolerance
+// kStoredMomentumTolerance); leapfrogRotation below rebuilds it instead.
 inline LeapfrogRotation leapfrogRotationWithMomentum(const Quat& q, const Vec3& omegaMid, const Vec3& angularMomentum,
                                                      const Vec3& inertia, const Vec3& torque, double dt,
-                                                     Damping damping, double alpha) {
+                                                     Damping damping, double alpha,
+                                                     double tolerance = kStoredMomentumTolerance) {
   LeapfrogRotation out;
   const Vec3& l0 = angularMomentum;
   if (damping == Damping::Viscous) {
@@ -159,8 +177,10 @@ inline LeapfrogRotation leapfrogRotationWithMomentum(const Quat& q, const Vec3& 
   }
   // Guess for w^(n+1/2): w^(n-1/2) advanced over dt by the kick and by the gyroscopic turn of the
   // inertia under L (dw/dt = I_world^-1 (L x w) when torque-free), both at q^n; error O(dt^2).
+  const Vec3 invInertia = inertia.cwiseInverse();
   const Vec3 change = out.angularMomentum - l0 + dt * l0.cross(omegaMid);
-  out.step = rotateUnderMomentum(q, out.angularMomentum, inertia, omegaMid + worldInertiaSolve(q, inertia, change), dt);
+  const Vec3 guess = omegaMid + worldInertiaTimes(q, invInertia, change);
+  out.step = rotateUnderMomentum(q, out.angularMomentum, invInertia, guess, dt, tolerance);
   return out;
 }
 
@@ -171,7 +191,7 @@ inline LeapfrogRotation leapfrogRotation(const Quat& q, const Vec3& omegaMid, co
                                          const Vec3& torque, double dt, double dtPrev, Damping damping,
                                          double alpha) {
   return leapfrogRotationWithMomentum(q, omegaMid, midStepAngularMomentum(q, omegaMid, inertia, dtPrev), inertia,
-                                      torque, dt, damping, alpha);
+                                      torque, dt, damping, alpha, kRebuiltMomentumTolerance);
 }
 
 // The mid-step angular velocity w^(-1/2) that starts a run whose body has angular velocity
@@ -179,7 +199,8 @@ inline LeapfrogRotation leapfrogRotation(const Quat& q, const Vec3& omegaMid, co
 inline Vec3 startingMidStepOmega(const Quat& q0, const Vec3& omega0, const Vec3& inertia, double dt) {
   const Vec3 l = worldInertiaTimes(q0, inertia, omega0);
   // A backward step from q0 under L: its mean angular velocity is w^(-1/2).
-  return rotateUnderMomentum(q0, -l, inertia, -omega0, dt).angularVelocity * -1.0;
+  return rotateUnderMomentum(q0, -l, inertia.cwiseInverse(), -omega0, dt, kRebuiltMomentumTolerance).angularVelocity *
+         -1.0;
 }
 
 // Rotational kinetic energy of the mid-step state: L.w/2 = L^T I_world(q*)^-1 L / 2, the energy of

@@ -23,6 +23,14 @@
 #include "geometry/ellipsoid_shape.hpp"
 #include "geometry/sphere_contacts.hpp"
 
+// The kernels are forced inline into the contact loops, as the sphere law is (contact/models.hpp):
+// called out of line, the solve's result went through the stack (profile of the micro-benchmark).
+#if defined(__GNUC__)
+#define GRAINLAB_ELLIPSOID_INLINE inline __attribute__((always_inline))
+#else
+#define GRAINLAB_ELLIPSOID_INLINE inline
+#endif
+
 namespace grainlab::geometry {
 
 // One ellipsoid contact. `geometry` has the engine's meaning (sphere_contacts.hpp): unit normal
@@ -71,7 +79,7 @@ struct GeneralPencil {
     Sym3 adj;
     double invDet;
   };
-  Eval operator()(double lambda) const {
+  GRAINLAB_ELLIPSOID_INLINE Eval operator()(double lambda) const {
     Eval e;
     const Sym3 g = xa + d * lambda;
     e.adj = g.adjugate();
@@ -102,7 +110,7 @@ struct DiagonalPencil {
   struct Eval : PencilValues {
     Vec3 invG;
   };
-  Eval operator()(double lambda) const {
+  GRAINLAB_ELLIPSOID_INLINE Eval operator()(double lambda) const {
     Eval e;
     e.invG = (xa + lambda * d).cwiseInverse();
     e.p = r.cwiseProduct(e.invG);
@@ -137,7 +145,7 @@ struct Solution {
 // kNewtonIterations, is replaced by bisection, so the solve cannot diverge. With stopWhenApart,
 // the first S(lambda) >= 1 ends it: F >= S(lambda) for every lambda, so the bodies are apart.
 template <class Pencil>
-inline Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhenApart) {
+GRAINLAB_ELLIPSOID_INLINE Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhenApart) {
   Solution sol;
   double lo = 0.0, hi = 1.0;
   double lambda = lambdaStart > 0.0 && lambdaStart < 1.0 ? lambdaStart : pencil.coldStart();
@@ -157,7 +165,8 @@ inline Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhen
     const double ds = (1.0 - 2.0 * lambda) * e.a0 - w * e.a1;
     const double d2s = -2.0 * e.a0 - 2.0 * (1.0 - 2.0 * lambda) * e.a1 + 2.0 * w * e.a2;
     if (ds > 0.0) lo = lambda; else hi = lambda;
-    const double step = -ds / d2s;
+    const double invD2s = 1.0 / d2s;
+    const double step = -ds * invD2s;
     const double next = lambda + step;
     const bool newton = it <= kNewtonIterations && d2s < 0.0;
     if (newton && std::abs(step) <= kStepTolerance) {
@@ -167,11 +176,11 @@ inline Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhen
       // Halley-like) and p, F extrapolated to it, all to O(step^3).
       const Vec3 dq = pencil.timesD(e.q);
       const double a3 = e.q.dot(dq);
-      const double d3s = 6.0 * (e.a1 + (1.0 - 2.0 * lambda) * e.a2 - w * a3);
-      const double delta = step - 0.5 * d3s / d2s * step * step;
+      const double d3sOver6 = e.a1 + (1.0 - 2.0 * lambda) * e.a2 - w * a3;  // S'''/6
+      const double delta = step - 3.0 * d3sOver6 * invD2s * step * step;
       sol.lambda = lambda + delta;
       sol.p = e.p + delta * (delta * pencil.solve(e, dq) - e.q);
-      sol.contactFunction = s + delta * (ds + delta * (0.5 * d2s + delta * d3s / 6.0));
+      sol.contactFunction = s + delta * (ds + delta * (0.5 * d2s + delta * d3sOver6));
       sol.converged = true;
       return sol;
     }
@@ -184,29 +193,36 @@ inline Solution maximise(const Pencil& pencil, double lambdaStart, bool stopWhen
   return sol;
 }
 
-// From the solved pencil to the contact. p = G^-1 R at the maximiser (any frame), n: the unit
-// normal (A -> B) in world coordinates, bPW = (1 - lambda) X_A p: the Perram–Wertheim point
-// relative to x_A, in world coordinates. At the maximiser (1 - lambda)^2 p.X_A p = lambda^2 p.X_B p
-// = F (S' = 0), so the PW point lies on both bodies scaled by sqrt F, with normal n, and the
+// From the solved pencil to the contact. p = G^-1 R at the maximiser, in world coordinates or in
+// a body frame that `toWorld` rotates to world (then n = toWorld p/|p|); bPW = (1 - lambda) X_A p:
+// the Perram–Wertheim point relative to x_A, in world coordinates. At the maximiser
+// (1 - lambda)^2 p.X_A p = lambda^2 p.X_B p = F (S' = 0), so the PW point lies on both bodies scaled by sqrt F, with normal n, and the
 // support distances along n come without another quadratic form:
 //     h_A = sqrt(n.X_A n) = sqrt(F)/((1 - lambda)|p|),   h_B = sqrt(F)/(lambda |p|).
 // The force line is n through the PW point; the contact point is moved along that line (which
 // changes no torque of the normal force) to midway between the two support planes, where the
 // sphere kernel puts it: n.(C - x_A) = (h_A - h_B + n.R)/2.
-inline void assemble(EllipsoidContact& c, const Vec3& r, const Vec3& p, const Vec3& n, const Vec3& bPW,
+GRAINLAB_ELLIPSOID_INLINE void assemble(EllipsoidContact& c, const Vec3& r, const Vec3& p, const Quat* toWorld, const Vec3& bPW,
                      double potentialLength) {
   const double sqrtF = std::sqrt(c.contactFunction);
-  const double scale = sqrtF / p.norm();
-  const double ha = scale / (1.0 - c.lambda), hb = scale / c.lambda;
+  const double pNorm = p.norm();
+  const double w = c.lambda * (1.0 - c.lambda);
+  // One division serves 1/|p|, H and 1/H: with inv = 1/(|p| sqrt(F) w),
+  // 1/|p| = sqrt(F) w inv, H = sqrt(F)/(|p| w) = F inv, 1/H = (|p| w)^2 inv.
+  const double inv = 1.0 / (pNorm * sqrtF * w);
+  const double invNorm = sqrtF * w * inv;
+  const double h = c.contactFunction * inv;
+  const double invH = (pNorm * w) * (pNorm * w) * inv;
+  const double ha = c.lambda * h, hb = (1.0 - c.lambda) * h;
   const double gap = 1.0 - sqrtF;  // > 0: overlapping
-  const double h = ha + hb;
   const double l = potentialLength > 0.0 ? potentialLength : h;
+  const Vec3 n = toWorld ? (*toWorld) * (p * invNorm) : Vec3(p * invNorm);
   c.touching = true;
   c.supportSum = h;
   c.depth = h * gap;
   c.potentialLength = l;
   c.geometry.normal = n;
-  c.geometry.overlap = l * l * gap / h;
+  c.geometry.overlap = l * l * gap * invH;
   c.energyOverKn = 0.5 * l * l * gap * gap;
   const double along = 0.5 * (ha - hb + n.dot(r));
   c.geometry.branchA = bPW + (along - n.dot(bPW)) * n;
@@ -241,7 +257,7 @@ inline EllipsoidContact coincidentCentres(double ha, double hb, double potential
 // H (what the engine passes on the first touching step under the frozen-length policy, then
 // keeps result.potentialLength). Swapping A and B flips the normal and gives lambda -> 1 - lambda,
 // the same overlap and the same contact point.
-inline EllipsoidContact ellipsoidEllipsoid(const Vec3& branch, const Sym3& xa, const Sym3& xb,
+GRAINLAB_ELLIPSOID_INLINE EllipsoidContact ellipsoidEllipsoid(const Vec3& branch, const Sym3& xa, const Sym3& xb,
                                            double lambdaPrev, double potentialLength) {
   if (branch.squaredNorm() == 0.0) {
     return pw::coincidentCentres(std::sqrt(xa.zz), std::sqrt(xb.zz), potentialLength);
@@ -254,14 +270,14 @@ inline EllipsoidContact ellipsoidEllipsoid(const Vec3& branch, const Sym3& xa, c
   c.iterations = s.iterations;
   c.converged = s.converged;
   if (s.apart || !(s.contactFunction < 1.0)) return c;
-  pw::assemble(c, branch, s.p, s.p.normalized(), (1.0 - s.lambda) * (xa * s.p), potentialLength);
+  pw::assemble(c, branch, s.p, nullptr, (1.0 - s.lambda) * (xa * s.p), potentialLength);
   return c;
 }
 
 // Sphere A (radius ra) against ellipsoid B (semi-axes, orientation qb), solved in B's body frame
 // where both shape matrices are diagonal (a specialised evaluation of the same contact function:
 // results agree with ellipsoidEllipsoid(branch, ra^2 I, X_B, ...) to round-off).
-inline EllipsoidContact sphereEllipsoid(const Vec3& branch, double ra, const Vec3& semiAxesB,
+GRAINLAB_ELLIPSOID_INLINE EllipsoidContact sphereEllipsoid(const Vec3& branch, double ra, const Vec3& semiAxesB,
                                         const Quat& qb, double lambdaPrev, double potentialLength) {
   if (branch.squaredNorm() == 0.0) {
     return pw::coincidentCentres(ra, std::sqrt(shapeMatrix(semiAxesB, qb).zz), potentialLength);
@@ -277,7 +293,7 @@ inline EllipsoidContact sphereEllipsoid(const Vec3& branch, double ra, const Vec
   c.iterations = s.iterations;
   c.converged = s.converged;
   if (s.apart || !(s.contactFunction < 1.0)) return c;
-  pw::assemble(c, branch, s.p, qb * s.p.normalized(), qb * ((1.0 - s.lambda) * ra * ra * s.p), potentialLength);
+  pw::assemble(c, branch, s.p, &qb, qb * ((1.0 - s.lambda) * ra * ra * s.p), potentialLength);
   return c;
 }
 
