@@ -83,13 +83,18 @@ struct GeneralPencil {
     Eval e;
     const Sym3 g = xa + d * lambda;
     e.adj = g.adjugate();
+    // The products run on the adjugate and the scaling by 1/det comes last, so that the
+    // division overlaps the matrix-vector products instead of preceding them (latency).
     e.invDet = 1.0 / g.determinant(e.adj);
-    e.p = (e.adj * r) * e.invDet;
-    const Vec3 dp = d * e.p;
-    e.q = (e.adj * dp) * e.invDet;
-    e.a0 = r.dot(e.p);
-    e.a1 = e.p.dot(dp);
-    e.a2 = dp.dot(e.q);
+    const Vec3 pa = e.adj * r;  // det p
+    const Vec3 dpa = d * pa;    // det D p
+    const Vec3 qa = e.adj * dpa;  // det^2 q
+    const double i2 = e.invDet * e.invDet;
+    e.p = pa * e.invDet;
+    e.q = qa * i2;
+    e.a0 = r.dot(pa) * e.invDet;
+    e.a1 = pa.dot(dpa) * i2;
+    e.a2 = dpa.dot(qa) * (i2 * e.invDet);
     return e;
   }
   Vec3 timesD(const Vec3& v) const { return d * v; }
