@@ -234,6 +234,16 @@ GRAINLAB_ELLIPSOID_INLINE void assemble(EllipsoidContact& c, const Vec3& r, cons
   c.geometry.branchB = c.geometry.branchA - r;
 }
 
+// The solve's part of a contact (all of it when the pair is apart).
+inline EllipsoidContact solveRecord(const Solution& s) {
+  EllipsoidContact c;
+  c.lambda = s.lambda;
+  c.contactFunction = s.contactFunction;
+  c.iterations = s.iterations;
+  c.converged = s.converged;
+  return c;
+}
+
 // Coincident centres: S vanishes for every lambda and no normal is defined. Report a deep contact
 // along world z rather than NaN (the engine should never get there; a sane time step forbids it).
 inline EllipsoidContact coincidentCentres(double ha, double hb, double potentialLength) {
@@ -269,11 +279,7 @@ GRAINLAB_ELLIPSOID_INLINE EllipsoidContact ellipsoidEllipsoid(const Vec3& branch
   }
   const pw::GeneralPencil pencil{xa, xb - xa, branch};
   const pw::Solution s = pw::maximise(pencil, lambdaPrev, true);
-  EllipsoidContact c;
-  c.lambda = s.lambda;
-  c.contactFunction = s.contactFunction;
-  c.iterations = s.iterations;
-  c.converged = s.converged;
+  EllipsoidContact c = pw::solveRecord(s);
   if (s.apart || !(s.contactFunction < 1.0)) return c;
   pw::assemble(c, branch, s.p, nullptr, (1.0 - s.lambda) * (xa * s.p), potentialLength);
   return c;
@@ -292,11 +298,7 @@ GRAINLAB_ELLIPSOID_INLINE EllipsoidContact sphereEllipsoid(const Vec3& branch, d
   const Vec3 xb = semiAxesB.cwiseProduct(semiAxesB);
   const pw::DiagonalPencil pencil{xa, xb - xa, rBody};
   const pw::Solution s = pw::maximise(pencil, lambdaPrev, true);
-  EllipsoidContact c;
-  c.lambda = s.lambda;
-  c.contactFunction = s.contactFunction;
-  c.iterations = s.iterations;
-  c.converged = s.converged;
+  EllipsoidContact c = pw::solveRecord(s);
   if (s.apart || !(s.contactFunction < 1.0)) return c;
   pw::assemble(c, branch, s.p, &qb, qb * ((1.0 - s.lambda) * ra * ra * s.p), potentialLength);
   return c;
