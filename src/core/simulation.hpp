@@ -60,6 +60,9 @@ class Simulation {
   // Exact binary state for checkpoints: a loaded simulation continues bit for bit.
   void saveState(std::ostream& out) const;
   void loadState(std::istream& in);
+  // Consistency of a loaded state before it is stepped (state_validate.cpp): sizes agree, indices
+  // in range, numbers finite. Throws InputError saying what is wrong.
+  void validateState() const;
 
  private:
   void computeContacts();
