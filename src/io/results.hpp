@@ -8,7 +8,11 @@
 
 namespace grainlab::io {
 
+// Writes `content` to `path` through a temporary file beside it (removed again on any failure).
+// Throws FileError naming the path and the system's reason.
 void writeFileAtomic(const std::filesystem::path& path, const std::string& content);
+// create_directories that throws FileError naming the folder and the system's reason.
+void createDirectories(const std::filesystem::path& dir);
 
 // The time series as CSV (header + one row per record). Throws SimulationError on a non-finite
 // value rather than writing it.
