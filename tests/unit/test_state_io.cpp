@@ -100,6 +100,9 @@ struct Sheared {
   lab::Laboratory lab{smallConfig()};
   std::string state;
   Sheared() {
+    // One thread: every test binary under ctest builds this again, and OpenMP threads on a busy
+    // 2-core machine slow down many times over.
+    omp_set_num_threads(1);
     lab.prepare();
     lab.beginShear();
     for (int i = 0; i < 300; ++i) lab.simulation().step();
@@ -115,7 +118,6 @@ Sheared& sheared() {
 }  // namespace
 
 TEST(StateIo, ReloadedLaboratoryContinuesBitForBit) {
-  omp_set_num_threads(1);
   Sheared& s = sheared();
   lab::Laboratory copy(smallConfig());
   stateio::MemoryInput in(s.state);
