@@ -6,6 +6,8 @@ PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli1
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev
       python3 python3-numpy python3-matplotlib python3-pytest python3-meshio
       libboost-dev)  # libboost-dev: header-only Boost.Math (Gauss–Legendre rules, micromechanics)
+# Checksums of checkpoints and packing files (xxHash), for the program and the Python readers.
+PKGS+=(libxxhash-dev python3-xxhash)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

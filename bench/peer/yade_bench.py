@@ -4,8 +4,8 @@
 Usage:
     yade -n -j THREADS -x bench/peer/yade_bench.py PACKING --steps S [--dt DT] [--warmup 200]
 
-PACKING is the scene's cached grainlab packing file (~/.cache/grainlab/triaxial-iso-N.txt: a '#'
-line, the six wall planes xlo xhi ylo yhi zlo zhi, then radius x y z per sphere). --dt is grainlab's
+PACKING is the scene's cached grainlab packing file (~/.cache/grainlab/triaxial-iso-N.txt, format 2
+or 1, read by packing_file.py: the six wall planes and the spheres). --dt is grainlab's
 time step for the same sample (printed by `grainlab bench --json`); without it 0.5 PWaveTimeStep().
 
 The scene of the grainlab bench: Ec = 30 GPa, ks/kn = 0.3, mu = 30 deg, contact moments with

@@ -1,12 +1,13 @@
 # -*- coding: utf-8 -*-
 """The YADE scene shared by the peer scripts (yade_triaxial.py, yade_bench.py): the [W] parameters,
-a grainlab packing file read back, the two CohFrictMat materials, six Box walls on the packing's
-planes (ids 0..5 = xlo, xhi, ylo, yhi, zlo, zhi, TriaxialStressController's numbering), the
-spheres, and the engine list. Imported by those scripts under `yade -x`, which puts their folder
+a grainlab packing file read back (format 2 or 1, by packing_file.py), the two CohFrictMat
+materials, six Box walls on the packing's planes (ids 0..5 = xlo, xhi, ylo, yhi, zlo, zhi,
+TriaxialStressController's numbering), the spheres, and the engine list. Imported by those scripts under `yade -x`, which puts their folder
 on sys.path first. The law YADE applies is documented in yade_triaxial.py.
 """
 import math
 
+from packing_file import read_packing  # noqa: F401 (the scripts call yade_scene.read_packing)
 from yade import O, utils
 from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, CohFrictMat, ForceResetter,
                           Ig2_Box_Sphere_ScGeom6D, Ig2_Sphere_Sphere_ScGeom6D,
@@ -21,15 +22,6 @@ BETA = 0.15             # alphaKr = alphaKtw
 ETA = 1.0               # etaRoll = etaTwist
 DENSITY = 2600.0        # [kg/m3]
 DAMPING = 0.3           # Cundall non-viscous damping
-
-
-def read_packing(path):
-    """(planes xlo xhi ylo yhi zlo zhi, [(radius, x, y, z)]) of a grainlab packing file."""
-    with open(path) as f:
-        lines = [l for l in f if l.strip() and not l.lstrip().startswith('#')]
-    planes = [float(v) for v in lines[0].split()]
-    spheres = [tuple(float(v) for v in l.split()[:4]) for l in lines[1:]]
-    return planes, spheres
 
 
 def build(planes, spheres, moments=True, wall_young=None):

@@ -6,8 +6,9 @@ Usage:
                                            [--rate 1.0] [--relax-steps 2000] [--wall-young 3e16]
                                            [--servo-integral 0.01]
 
-PACKING: first line a '#' comment; second line the six wall planes xlo xhi ylo yhi zlo zhi [m];
-then one sphere per line: radius x y z [m] (the packing is assumed to be in equilibrium).
+PACKING: a grainlab packing file (README "Packing files": format 2, or format 1 with a '#' comment,
+the six wall planes xlo xhi ylo yhi zlo zhi [m], then radius x y z [m] per sphere), read by
+packing_file.py; the packing is assumed to be in equilibrium.
 
 Contact law: YADE's CohFrictMat / CohFrictPhys with Law2_ScGeom6D_CohFrictPhys_CohesionMoment
 (incremental moments, no cohesion). What YADE 2023.02a computes for a contact between spheres of
@@ -59,7 +60,7 @@ from yade_scene import BETA, YOUNG  # noqa: E402
 # ---------------------------------------------------------------------------------------------
 parser = argparse.ArgumentParser(prog='yade -n -x yade_triaxial.py',
                                  description='YADE peer run of the grainlab triaxial test')
-parser.add_argument('packing', help='packing file (walls line + radius x y z per sphere)')
+parser.add_argument('packing', help='grainlab packing file (format 2 or 1)')
 parser.add_argument('out', help='output CSV path')
 parser.add_argument('--no-moments', action='store_true',
                     help='disable contact moments (momentRotationLaw=False, alphaKr=etaRoll=0)')

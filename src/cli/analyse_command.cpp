@@ -3,11 +3,7 @@
 // other options without rerunning. Writes DIR/micro/analysis.csv and analysis.json, the class
 // averages of every snapshot (classes_NNNN.csv, classes_NNNN.vtu, classes.pvd) and the plots
 // (DIR/plots/rose_*.png, micro_*.png) drawn by tools/plot_micro.py.
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,13 +12,14 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "io/install_paths.hpp"
+#include "io/process.hpp"
 #include "core/errors.hpp"
 #include "io/micro_output.hpp"
 #include "io/micro_snapshot.hpp"
 #include "io/results.hpp"
 #include "io/vtu_piece.hpp"
 
-extern char** environ;
 
 namespace grainlab::cli {
 
@@ -30,27 +27,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Runs `python tools/plot_micro.py DIR` (an argument vector, no shell); false when it failed.
+// Runs `python tools/plot_micro.py DIR` from the data folder beside the executable (an argument
+// vector, no shell); false when the script is missing or failed.
 bool drawPlots(const fs::path& dir, bool quiet) {
-  const fs::path script = fs::path(GRAINLAB_SOURCE_DIR) / "tools" / "plot_micro.py";
-  if (!fs::exists(script)) return false;
-  std::vector<std::string> args{GRAINLAB_PYTHON, script.string(), dir.string()};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  if (quiet) {
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  }
-  pid_t pid = 0;
-  const int rc = ::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) return false;
-  int status = 0;
-  if (::waitpid(pid, &status, 0) != pid) return false;
-  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  const fs::path script = io::toolScript("plot_micro.py");
+  if (script.empty() || !fs::exists(script)) return false;
+  return io::runProcess({GRAINLAB_PYTHON, script.string(), dir.string()},
+                        quiet ? io::ChildOutput::discard() : io::ChildOutput::inherit()) == 0;
 }
 
 std::string show(const std::optional<double>& v, const char* format = "{:7.3f}") {

@@ -12,6 +12,7 @@
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 #include "io/packing.hpp"
 #include "io/results.hpp"
 #include "lab/measurements.hpp"
@@ -93,13 +94,15 @@ int runBench(const BenchOptions& opt) {
   if (opt.scene == "lattice") {
     buildLattice(opt.particles, config.sample.density, sim);
   } else if (fs::exists(cache)) {
-    io::loadPacking(cache, config.sample.density, sim);
+    const std::string subject = fmt::format("bench cache {}", io::quotedPath(cache));
+    io::simulationFromPacking(io::parsePacking(io::readInputFile(cache, subject, io::kMaxPackingBytes), subject),
+                              config.sample.density, sim, subject);
   } else {
     if (!opt.json) fmt::print(stderr, "preparing the {}-particle sample (cached in {})\n", opt.particles, cache.string());
     lab::Laboratory lab(config);
     lab.prepare();
     sim = lab.simulation();
-    io::writeFileAtomic(cache, io::packingText(sim, "grainlab bench sample " + opt.scene));
+    io::writeFileAtomic(cache, io::packingText(io::packingFromSimulation(sim, "grainlab bench sample " + opt.scene)));
   }
   lab::configureSolver(config, sim);
   if (opt.scene != "lattice") {

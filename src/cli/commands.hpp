@@ -1,9 +1,18 @@
 #pragma once
 // The subcommands of the grainlab executable.
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/simulation.hpp"
+#include "lab/run_config.hpp"
+
 namespace grainlab::cli {
+
+// Reads and validates every file a config names (grading list, sphericity CSV, packing) as a run
+// would use it, before anything is written; returns the packed sample of sample.packing. Throws
+// InputError naming the key, the file and the line.
+std::optional<Simulation> loadInputFiles(const lab::RunConfig& config);
 
 struct RunOptions {
   std::string config;
@@ -17,6 +26,7 @@ int runLab(const RunOptions& options);
 struct ResumeOptions {
   std::string dir;
   bool quiet = false;
+  bool allowOlderVersion = false;  // accept a checkpoint of an older grainlab with the same format
 };
 // `grainlab resume DIR`: continues an interrupted run from its checkpoint.
 int resumeLab(const ResumeOptions& options);

@@ -4,11 +4,21 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 #include "io/presets.hpp"
+
+namespace {
+
+// Every error is one line on stderr, whatever bytes a value or path in it had (the values in a
+// message are cut already; this bounds the whole).
+std::string oneLine(const std::string& message) { return grainlab::io::printable(message, 600); }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace grainlab;
@@ -32,6 +42,8 @@ int main(int argc, char** argv) {
   auto* resumeCmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
   resumeCmd->add_option("dir", resume.dir, "results folder of the run")->required();
   resumeCmd->add_flag("--quiet", resume.quiet, "no progress output");
+  resumeCmd->add_flag("--allow-older-version", resume.allowOlderVersion,
+                      "accept a checkpoint written by an older grainlab (same checkpoint format)");
 
   cli::SweepOptions sweep;
   auto* sweepCmd = app.add_subcommand("sweep", "Run a grid of overrides in parallel processes and compare them");
@@ -68,8 +80,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "grainlab: %s (grainlab --help lists the options)\n", io::printable(e.what(), 300).c_str());
+    return 2;
   }
 
   try {
@@ -84,13 +97,23 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("resume")) return cli::resumeLab(resume);
     return cli::runLab(run);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "grainlab: %s\n", e.what());
+    std::fprintf(stderr, "grainlab: %s\n", oneLine(e.what()).c_str());
     return 2;
   } catch (const SimulationError& e) {
-    std::fprintf(stderr, "grainlab: run failed: %s\n", e.what());
+    std::fprintf(stderr, "grainlab: run failed: %s\n", oneLine(e.what()).c_str());
+    return 1;
+  } catch (const io::FileError& e) {
+    std::fprintf(stderr, "grainlab: %s\n", oneLine(e.what()).c_str());
+    return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::fprintf(stderr, "grainlab: %s\n",
+                 oneLine(fmt::format("{} {}: {}", e.what(), io::quotedPath(e.path1()), e.code().message())).c_str());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "grainlab: out of memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "grainlab: error: %s\n", e.what());
+    std::fprintf(stderr, "grainlab: error: %s\n", oneLine(e.what()).c_str());
     return 1;
   }
 }

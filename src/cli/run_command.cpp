@@ -4,21 +4,29 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
+#include <functional>
+#include <optional>
 #include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
+#include "core/state_io.hpp"
+#include "io/checkpoint_file.hpp"
 #include "io/config.hpp"
+#include "io/input_file.hpp"
+#include "io/install_paths.hpp"
 #include "io/packing.hpp"
-#include "io/vtk.hpp"
+#include "io/process.hpp"
 #include "io/results.hpp"
+#include "io/run_folder.hpp"
+#include "io/vtk.hpp"
+#include "lab/grading.hpp"
 #include "lab/macro.hpp"
 #include "lab/protocols.hpp"
+#include "lab/sphericity.hpp"
 
 namespace grainlab::cli {
 
@@ -46,27 +54,56 @@ json equilibriumJson(const lab::EquilibriumState& s) {
           {"void_ratio", s.voidRatio}};
 }
 
+// JSON text of a summary; a path that is not UTF-8 (config_source) is written with U+FFFD in
+// place of its invalid bytes rather than failing the run.
+std::string jsonText(const json& j) { return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n"; }
+
+// tools/plot_run.py of the installed data folder, started with an argument vector (no shell: the
+// folder name reaches the script byte for byte).
 void makePlots(const fs::path& dir, bool quiet) {
-  const fs::path script = fs::path(GRAINLAB_SOURCE_DIR) / "tools" / "plot_run.py";
-  if (!fs::exists(script)) return;
-  const std::string cmd = fmt::format("\"{}\" \"{}\" \"{}\"{}", GRAINLAB_PYTHON, script.string(),
-                                      dir.string(), quiet ? " >/dev/null 2>&1" : "");
-  if (std::system(cmd.c_str()) != 0)
-    std::fprintf(stderr, "grainlab: warning: plotting failed (results are complete without plots)\n");
+  const fs::path script = io::toolScript("plot_run.py");
+  if (script.empty()) {
+    std::fprintf(stderr,
+                 "grainlab: warning: plot_run.py not found in share/grainlab/tools beside the executable; the results "
+                 "are complete without plots\n");
+    return;
+  }
+  try {
+    const int rc = io::runProcess({GRAINLAB_PYTHON, script.string(), dir.string()},
+                                  quiet ? io::ChildOutput::discard() : io::ChildOutput::inherit());
+    if (rc != 0)
+      std::fprintf(stderr, "grainlab: warning: plotting failed (exit %d); the results are complete without plots\n", rc);
+  } catch (const io::FileError& e) {
+    std::fprintf(stderr, "grainlab: warning: %s; the results are complete without plots\n", e.what());
+  }
 }
 
 lab::RunConfig resolveConfig(const RunOptions& opt) {
   toml::table table = io::loadConfigTable(opt.config);
   for (const auto& s : opt.overrides) io::applyOverride(table, s);
-  if (!opt.outDir.empty()) io::applyOverride(table, "output.dir=\"" + opt.outDir + "\"");
+  if (!opt.outDir.empty()) io::setOutputDir(table, opt.outDir);
   if (opt.threads > 0) io::applyOverride(table, fmt::format("solver.threads={}", opt.threads));
   return io::parseConfig(table, io::configBaseDir(opt.config));
 }
 
 }  // namespace
 
+std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
+  if (config.sample.grading.type == "list") lab::readDiameterList(config.sample.grading.file);
+  if (config.contact.sphericity) lab::readSphericityFile(config.contact.sphericity->file, "contact.sphericity.file");
+  if (config.sample.packing.empty()) return std::nullopt;
+  const io::PackingData packing = io::readPackingFile(config.sample.packing, "sample.packing");
+  Simulation packed;
+  io::simulationFromPacking(packing, config.sample.density, packed,
+                            fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
+  return packed;
+}
+
 int checkConfig(const RunOptions& opt) {
-  std::fputs(io::toTomlString(io::resolvedTable(resolveConfig(opt))).c_str(), stdout);
+  const lab::RunConfig config = resolveConfig(opt);
+  loadInputFiles(config);
+  io::RunFolder::checkReplaceable(config.output.dir);
+  std::fputs(io::toTomlString(io::resolvedTable(config)).c_str(), stdout);
   return 0;
 }
 
@@ -76,9 +113,10 @@ namespace {
 // `run` and `resume`; `summary` already holds what preparation reported.
 class RunSession {
  public:
-  RunSession(const lab::RunConfig& config, fs::path dir, bool quiet, json summary, double secondsBefore,
-             std::vector<double> vtkLabels = {})
-      : config_(config), dir_(std::move(dir)), quiet_(quiet), progress_(quiet),
+  // Writes into folder.work(); messages name folder.target(), where the results end up.
+  RunSession(const lab::RunConfig& config, const io::RunFolder& folder, bool quiet, json summary,
+             double secondsBefore, std::vector<double> vtkLabels = {})
+      : config_(config), dir_(folder.work()), target_(folder.target()), quiet_(quiet), progress_(quiet),
         summary_(std::move(summary)), secondsBefore_(secondsBefore), t0_(std::chrono::steady_clock::now()),
         vtk_(dir_ / "vtk", std::move(vtkLabels)),
         lab_(config, [this](const std::string& phase, double f, long steps) { progress_.update(phase, f, steps); }) {
@@ -111,15 +149,13 @@ class RunSession {
     return secondsBefore_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
   }
 
-  // checkpoint/state.bin: a JSON header line (summary so far, VTK snapshot times, wall time) and the
-  // exact binary state, written as one file and renamed into place.
+  // checkpoint/state.bin: the run so far (summary, VTK snapshot labels, wall time) and the exact
+  // binary state, in the checked container of io/checkpoint_file.hpp, renamed into place.
   void writeCheckpoint() {
-    json header{{"format", "grainlab-checkpoint-2"}, {"version", GRAINLAB_VERSION}, {"summary", summary_},
-                {"vtk_labels", vtk_.labels()}, {"wall_seconds", seconds()}};
-    std::ostringstream out(std::ios::binary);
-    out << header.dump() << '\n';
-    lab_.saveState(out);
-    io::writeFileAtomic(dir_ / "checkpoint" / "state.bin", out.str());
+    const json record{{"summary", summary_}, {"vtk_labels", vtk_.labels()}, {"wall_seconds", seconds()}};
+    std::ostringstream state(std::ios::binary);
+    lab_.saveState(state);
+    io::writeFileAtomic(dir_ / "checkpoint" / "state.bin", io::encodeCheckpoint(config_, record, state.str()));
   }
 
   // Shears (from the start, or from where a loaded checkpoint left off) and writes every result.
@@ -206,7 +242,7 @@ class RunSession {
     summary_["status"] = "failed";
     summary_["error"] = what;
     summary_["wall_seconds"] = seconds();
-    io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
+    io::writeFileAtomic(dir_ / "summary.json", jsonText(summary_));
   }
 
  private:
@@ -214,12 +250,14 @@ class RunSession {
     const double wall = seconds();
     summary_["steps"] = steps;
     summary_["wall_seconds"] = wall;
-    summary_["particle_steps_per_s"] = static_cast<double>(steps) * config_.sample.nParticles / wall;
+    // The particles simulated (a packing file brings its own number, whatever sample.n_particles says).
+    summary_["particle_steps_per_s"] =
+        static_cast<double>(steps) * static_cast<double>(lab_.simulation().particles.size()) / wall;
     summary_["status"] = "completed";
     io::TimeseriesColumns columns = io::timeseriesColumns(config_);
     columns.micro = lab_.microColumnNames();
     io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, columns));
-    io::writeFileAtomic(dir_ / "summary.json", summary_.dump(2) + "\n");
+    io::writeFileAtomic(dir_ / "summary.json", jsonText(summary_));
     if (config_.output.plots) makePlots(dir_, quiet_);
     if (!quiet_) {
       if (summary_.contains("G_MPa"))
@@ -233,13 +271,13 @@ class RunSession {
                     summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
                     summary_["phi_res_deg"].get<double>(), summary_["psi_max_deg"].get<double>(),
                     summary_["E_MPa"].get<double>(), summary_["nu"].get<double>());
-      std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, dir_.c_str());
+      std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, io::printable(target_.native(), 240).c_str());
     }
     return 0;
   }
 
   const lab::RunConfig& config_;
-  fs::path dir_;
+  fs::path dir_, target_;
   bool quiet_;
   ProgressLine progress_;
   json summary_;
@@ -258,117 +296,141 @@ int finish(RunSession& session, const lab::RunConfig& config) {
   }
 }
 
+// Runs `body` (which writes into folder.work()) and puts its results in place; on the way out of a
+// refused input, or of a failed re-run, removes what it wrote (the earlier results stay as they were).
+int inFolder(io::RunFolder& folder, const std::function<int()>& body) {
+  int rc = 0;
+  try {
+    rc = body();
+  } catch (const InputError&) {
+    folder.discard();
+    throw;
+  } catch (const SimulationError& e) {
+    if (!folder.staged()) throw;  // a new folder keeps the failed run's summary
+    folder.discard();
+    throw SimulationError(fmt::format("{}; the earlier results in {} are left as they were", e.what(),
+                                      io::quotedPath(folder.target())));
+  } catch (...) {
+    if (folder.staged()) folder.discard();
+    throw;
+  }
+  folder.commit();
+  return rc;
+}
+
 }  // namespace
 
 int runLab(const RunOptions& opt) {
   const lab::RunConfig config = resolveConfig(opt);
+  // Every input file is read and checked before the results folder is touched.
+  std::optional<Simulation> packed = loadInputFiles(config);
   omp_set_num_threads(config.solver.threads);
-  const fs::path dir = config.output.dir;
-  fs::create_directories(dir);
-  io::writeFileAtomic(dir / "config.resolved.toml", io::toTomlString(io::resolvedTable(config)));
-  // A new run replaces whatever an earlier run left in the folder's checkpoint.
-  fs::remove_all(dir / "checkpoint");
+  io::RunFolder folder = io::RunFolder::forRun(config.output.dir);
+  return inFolder(folder, [&] {
+    const fs::path dir = folder.work();
+    io::writeFileAtomic(dir / "config.resolved.toml", io::toTomlString(io::resolvedTable(config)));
 
-  json summary;
-  summary["config_source"] = opt.config;
-  summary["n_particles"] = config.sample.nParticles;
-  summary["confining_pressure"] = config.test.confiningPressure;
-  summary["test"] = config.test.type;
-  summary["e0_target"] = config.sample.e0;
-  summary["threads"] = config.solver.threads;
-  RunSession session(config, dir, opt.quiet, summary, 0.0);
-  lab::Laboratory& lab = session.lab();
-  try {
-    lab::PreparationResult prep;
-    if (config.sample.packing.empty()) {
-      prep = lab.prepare();
-    } else {
-      Simulation packed;
-      io::loadPacking(config.sample.packing, config.sample.density, packed);
-      prep = lab.adoptPacking(std::move(packed));
+    json summary;
+    summary["config_source"] = opt.config;
+    summary["n_particles"] = packed ? packed->particles.size() : static_cast<std::size_t>(config.sample.nParticles);
+    summary["confining_pressure"] = config.test.confiningPressure;
+    summary["test"] = config.test.type;
+    summary["e0_target"] = config.sample.e0;
+    summary["threads"] = config.solver.threads;
+    RunSession session(config, folder, opt.quiet, summary, 0.0);
+    lab::Laboratory& lab = session.lab();
+    try {
+      const lab::PreparationResult prep = packed ? lab.adoptPacking(std::move(*packed)) : lab.prepare();
+      session.progress().finish();
+      const Simulation& sim = lab.simulation();
+      if (config.output.savePacking)
+        io::writeFileAtomic(
+            dir / "packing.txt",
+            io::packingText(io::packingFromSimulation(
+                sim, fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}", prep.e0,
+                                 config.test.confiningPressure, config.sample.seed))));
+      json& s = session.summary();
+      s["n_particles"] = sim.particles.size();
+      s["e0"] = finite(prep.e0, "e0");
+      // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
+      s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
+      s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
+      // A packing file is taken as it is: no preparation friction was used.
+      s["prep_friction_deg"] = prep.prepFrictionDeg ? json(*prep.prepFrictionDeg) : json(nullptr);
+      s["preparation_method"] = config.sample.packing.empty() ? config.sample.method : "packing file";
+      json search = json::array();
+      for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
+      s["prep_search"] = search;
+      s["grading"] = gradingJson(prep.grading);
+      if (config.contact.model == "rolling-linear") {
+        const auto& mu = sim.particles.rollingFriction;
+        double sum = 0.0;
+        for (double m : mu) sum += m;
+        s["mu_r_mean"] = sum / static_cast<double>(mu.size());
+        s["mu_r_min"] = *std::min_element(mu.begin(), mu.end());
+        s["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
+      }
+      s["isotropic_state"] = equilibriumJson(prep.state);
+      s["dt"] = sim.dt;
+      s["dt_critical"] = sim.criticalTimeStep();
+      s["preparation_steps"] = prep.steps;
+      if (!opt.quiet) {
+        const std::string how = config.sample.packing.empty()
+                                    ? fmt::format("target {:.3f}, mu_prep = {:.2f} deg", config.sample.e0, prep.prepFrictionDeg.value_or(0.0))
+                                    : std::string("from the packing file");
+        std::fprintf(stderr, "prepared: e0 = %.4f (%s), p = %.1f kPa\n", prep.e0, how.c_str(),
+                     (prep.state.boundaryStress.sum() / 3.0) / 1e3);
+      }
+    } catch (const SimulationError& e) {
+      session.writeFailure(e.what());
+      throw;
     }
-    session.progress().finish();
-    const Simulation& sim = lab.simulation();
-    if (config.output.savePacking)
-      io::writeFileAtomic(dir / "packing.txt",
-                          io::packingText(sim, fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}",
-                                                           prep.e0, config.test.confiningPressure, config.sample.seed)));
-    json& s = session.summary();
-    s["e0"] = finite(prep.e0, "e0");
-    // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
-    s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
-    s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
-    // No preparation friction was used for a sample read from a packing file: null, not a number.
-    s["prep_friction_deg"] = prep.prepFrictionDeg ? json(*prep.prepFrictionDeg) : json(nullptr);
-    s["preparation_method"] = config.sample.packing.empty() ? config.sample.method : "packing file";
-    json search = json::array();
-    for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
-    s["prep_search"] = search;
-    s["grading"] = gradingJson(prep.grading);
-    if (config.contact.model == "rolling-linear") {
-      const auto& mu = sim.particles.rollingFriction;
-      double sum = 0.0;
-      for (double m : mu) sum += m;
-      s["mu_r_mean"] = sum / static_cast<double>(mu.size());
-      s["mu_r_min"] = *std::min_element(mu.begin(), mu.end());
-      s["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
-    }
-    s["isotropic_state"] = equilibriumJson(prep.state);
-    s["dt"] = sim.dt;
-    s["dt_critical"] = sim.criticalTimeStep();
-    s["preparation_steps"] = prep.steps;
-    if (!opt.quiet)
-      std::fprintf(stderr, "prepared: e0 = %.4f (target %.3f, mu_prep = %.2f deg), p = %.1f kPa\n",
-                   prep.e0, config.sample.e0, prep.prepFrictionDeg.value_or(0.0), (prep.state.boundaryStress.sum() / 3.0) / 1e3);
-  } catch (const SimulationError& e) {
-    session.writeFailure(e.what());
-    throw;
-  }
-  return finish(session, config);
+    return finish(session, config);
+  });
 }
 
 int resumeLab(const ResumeOptions& opt) {
-  const fs::path dir = opt.dir;
+  io::RunFolder folder = io::RunFolder::forResume(opt.dir);
+  const fs::path dir = folder.work();
   const fs::path stateFile = dir / "checkpoint" / "state.bin";
-  if (!fs::exists(dir / "config.resolved.toml"))
-    throw InputError(fmt::format("resume {}: no config.resolved.toml there (not a grainlab results folder)", dir.string()));
-  if (!fs::exists(stateFile))
-    throw InputError(fmt::format("resume {}: no checkpoint/state.bin (checkpoints are written during shearing, "
-                                 "every output.checkpoint_every of axial strain)", dir.string()));
-  RunOptions resolved;
-  resolved.config = (dir / "config.resolved.toml").string();
-  lab::RunConfig config = resolveConfig(resolved);
-  omp_set_num_threads(config.solver.threads);
-  if (fs::exists(dir / "summary.json")) {
-    std::ifstream in(dir / "summary.json");
-    json done;
-    in >> done;
-    if (done.value("status", "") == "completed") {
-      if (!opt.quiet) std::printf("%s: run already completed\n", dir.c_str());
+  std::error_code ec;
+  if (!fs::exists(dir / "config.resolved.toml", ec))
+    throw InputError(fmt::format("resume {}: no config.resolved.toml there (not a grainlab results folder)",
+                                 io::quotedPath(opt.dir)));
+  if (!folder.staged() && fs::exists(dir / "summary.json", ec)) {
+    const json done = json::parse(io::readInputFile(dir / "summary.json", "resume: summary.json", io::kMaxConfigBytes),
+                                  nullptr, false);
+    if (done.is_object() && done.value("status", "") == "completed") {
+      if (!opt.quiet) std::printf("%s: run already completed\n", io::printable(dir.native(), 240).c_str());
       return 0;
     }
   }
-  std::ifstream in(stateFile, std::ios::binary);
-  std::string headerLine;
-  std::getline(in, headerLine);
-  json header;
+  if (!fs::exists(stateFile, ec))
+    throw InputError(fmt::format("resume {}: no checkpoint/state.bin (checkpoints are written during shearing, "
+                                 "every output.checkpoint_every of axial strain)",
+                                 io::quotedPath(opt.dir)));
+  RunOptions resolved;
+  resolved.config = (dir / "config.resolved.toml").string();
+  const lab::RunConfig config = resolveConfig(resolved);
+  const io::Checkpoint checkpoint = io::readCheckpointFile(stateFile);
+  io::checkCheckpointBelongs(checkpoint, stateFile, config, opt.allowOlderVersion);
+  omp_set_num_threads(config.solver.threads);
+  const json& record = checkpoint.record;
+  RunSession session(config, folder, opt.quiet, record["summary"], record["wall_seconds"].get<double>(),
+                     record["vtk_labels"].get<std::vector<double>>());
   try {
-    header = json::parse(headerLine);
-  } catch (const json::exception&) {
-    throw InputError(fmt::format("resume {}: checkpoint/state.bin is not a grainlab checkpoint", dir.string()));
-  }
-  if (header.value("format", "") != "grainlab-checkpoint-2" || header.value("version", "") != GRAINLAB_VERSION)
-    throw InputError(fmt::format("resume {}: checkpoint written by another grainlab version ({})", dir.string(),
-                                 header.value("version", "?")));
-  RunSession session(config, dir, opt.quiet, header["summary"], header.value("wall_seconds", 0.0),
-                     header["vtk_labels"].get<std::vector<double>>());
-  try {
+    stateio::MemoryInput in(checkpoint.state);
     session.lab().loadState(in);
+    if (in.bytesLeft() != 0) throw stateio::StateError(fmt::format("{} bytes left over after the state", in.bytesLeft()));
+    session.lab().simulation().validateState();
   } catch (const std::exception& e) {
-    throw InputError(fmt::format("resume {}: cannot read the checkpoint: {}", dir.string(), e.what()));
+    throw InputError(fmt::format("checkpoint {}: cannot be resumed: {}", io::quotedPath(stateFile), e.what()));
   }
-  if (!opt.quiet) std::fprintf(stderr, "resuming %s at step %ld\n", dir.c_str(), session.lab().simulation().stepCount);
-  return finish(session, config);
+  if (!opt.quiet)
+    std::fprintf(stderr, "resuming %s at step %ld\n", io::printable(dir.native(), 240).c_str(),
+                 session.lab().simulation().stepCount);
+  // A resumed re-run replaces the earlier results only once complete, as the run would have.
+  return inFolder(folder, [&] { return finish(session, config); });
 }
 
 }  // namespace grainlab::cli

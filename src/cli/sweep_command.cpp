@@ -1,16 +1,9 @@
 // `grainlab sweep`: a grid of config overrides run as parallel processes, then one comparison table
 // and overlay plots. A failed case is reported and does not stop the others.
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cctype>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <thread>
 #include <nlohmann/json.hpp>
@@ -18,9 +11,10 @@
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
 #include "io/config.hpp"
+#include "io/input_file.hpp"
+#include "io/install_paths.hpp"
+#include "io/process.hpp"
 #include "io/results.hpp"
-
-extern char** environ;
 
 namespace grainlab::cli {
 
@@ -113,11 +107,11 @@ int runSweep(const SweepOptions& opt) {
     toml::table table = io::loadConfigTable(opt.config);
     for (const auto& s : opt.overrides) io::applyOverride(table, s);
     for (const auto& [k, v] : c) io::applyOverride(table, k + "=" + v);
-    io::parseConfig(table, io::configBaseDir(opt.config));
+    loadInputFiles(io::parseConfig(table, io::configBaseDir(opt.config)));
   }
   const fs::path out = opt.outDir.empty() ? fs::path("runs/sweep") : fs::path(opt.outDir);
-  fs::create_directories(out);
-  const std::string self = fs::read_symlink("/proc/self/exe").string();
+  io::createDirectories(out);
+  const std::string self = io::executablePath().string();
 
   struct Job {
     std::string name;
@@ -139,12 +133,11 @@ int runSweep(const SweepOptions& opt) {
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0, done = 0;
   auto wait_one = [&] {
-    int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, 0);
-    if (pid <= 0 || !running.count(pid)) return;
+    const auto [pid, code] = io::waitAnyProcess();
+    if (!running.count(pid)) return;
     const std::size_t i = running[pid];
     running.erase(pid);
-    jobs[i].status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    jobs[i].status = code;
     ++done;
     if (!opt.quiet)
       std::fprintf(stderr, "[%zu/%zu] %s: %s\n", done, cases.size(), jobs[i].name.c_str(),
@@ -157,18 +150,7 @@ int runSweep(const SweepOptions& opt) {
       if (threadsPerCase > 0) args.insert(args.end(), {"--threads", std::to_string(threadsPerCase)});
       for (const auto& s : opt.overrides) args.insert(args.end(), {"--set", s});
       for (const auto& [k, v] : cases[next]) args.insert(args.end(), {"--set", k + "=" + v});
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      const fs::path log = out / (jobs[next].name + ".log");
-      posix_spawn_file_actions_t actions;
-      posix_spawn_file_actions_init(&actions);
-      posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-      pid_t pid = 0;
-      const int rc = ::posix_spawn(&pid, self.c_str(), &actions, nullptr, argv.data(), environ);
-      posix_spawn_file_actions_destroy(&actions);
-      if (rc != 0) throw std::runtime_error(fmt::format("sweep: cannot start {}: {}", self, std::strerror(rc)));
+      const pid_t pid = io::startProcess(args, io::ChildOutput::toFile(out / (jobs[next].name + ".log")));
       running[pid] = next++;
     }
     wait_one();
@@ -186,8 +168,14 @@ int runSweep(const SweepOptions& opt) {
   int failed = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     nlohmann::json summary;
-    std::ifstream in(out / jobs[i].name / "summary.json");
-    if (in) in >> summary;
+    if (jobs[i].status == 0) {
+      try {
+        summary = nlohmann::json::parse(
+            io::readInputFile(out / jobs[i].name / "summary.json", "summary.json", io::kMaxConfigBytes), nullptr, false);
+      } catch (const InputError&) {
+        // Missing or unreadable: the row keeps empty cells.
+      }
+    }
     const std::string status = jobs[i].status == 0 ? "completed" : fmt::format("failed (exit {})", jobs[i].status);
     failed += jobs[i].status != 0;
     csv += csvField(jobs[i].name) + "," + csvField(status);
@@ -200,13 +188,21 @@ int runSweep(const SweepOptions& opt) {
     csv += "\n";
   }
   io::writeFileAtomic(out / "sweep.csv", csv);
-  const fs::path script = fs::path(GRAINLAB_SOURCE_DIR) / "tools" / "plot_sweep.py";
-  if (fs::exists(script)) {
-    const std::string cmd = fmt::format("\"{}\" \"{}\" \"{}\" >/dev/null 2>&1", GRAINLAB_PYTHON, script.string(), out.string());
-    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "grainlab: warning: sweep plots failed\n");
+  // Overlay plots: tools/plot_sweep.py with an argument vector (no shell), output discarded.
+  const fs::path script = io::toolScript("plot_sweep.py");
+  if (script.empty()) {
+    std::fprintf(stderr, "grainlab: warning: plot_sweep.py not found in share/grainlab/tools beside the executable\n");
+  } else {
+    try {
+      if (io::runProcess({GRAINLAB_PYTHON, script.string(), out.string()}, io::ChildOutput::discard()) != 0)
+        std::fprintf(stderr, "grainlab: warning: sweep plots failed\n");
+    } catch (const io::FileError& e) {
+      std::fprintf(stderr, "grainlab: warning: sweep plots: %s\n", e.what());
+    }
   }
   if (!opt.quiet)
-    std::printf("%zu cases, %d failed; table in %s\n", cases.size(), failed, (out / "sweep.csv").c_str());
+    std::printf("%zu cases, %d failed; table in %s\n", cases.size(), failed,
+                io::printable((out / "sweep.csv").native(), 240).c_str());
   return failed == 0 ? 0 : 1;
 }
 

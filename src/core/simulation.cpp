@@ -335,6 +335,48 @@ void Simulation::integrateFor() {
   }
 }
 
+// Every field of PeriodicCell but hInverse, which follows from h.
+static_assert(stateio::fieldCount<PeriodicCell>() == 16, "PeriodicCell changed: update saveCell/loadCell");
+
+void Simulation::saveCell(std::ostream& out) const {
+  using namespace stateio;
+  put(out, cell.h);
+  put(out, cell.velocityGradient);
+  put(out, cell.control);
+  put(out, cell.targetStress);
+  put(out, cell.strainRate);
+  put(out, cell.referenceLength);
+  put(out, cell.shearControl);
+  put(out, cell.targetShearStress);
+  put(out, cell.shearServoIntegral);
+  put(out, cell.shearRate);
+  put(out, cell.servoIntegral);
+  put(out, cell.prescribedGradient);
+  put(out, cell.stress);
+  put(out, cell.stiffness);
+  put(out, cell.shearStiffness);
+}
+
+void Simulation::loadCell(std::istream& in) {
+  using namespace stateio;
+  get(in, cell.h);
+  get(in, cell.velocityGradient);
+  get(in, cell.control);
+  get(in, cell.targetStress);
+  get(in, cell.strainRate);
+  get(in, cell.referenceLength);
+  get(in, cell.shearControl);
+  get(in, cell.targetShearStress);
+  get(in, cell.shearServoIntegral);
+  get(in, cell.shearRate);
+  get(in, cell.servoIntegral);
+  get(in, cell.prescribedGradient);
+  get(in, cell.stress);
+  get(in, cell.stiffness);
+  get(in, cell.shearStiffness);
+  cell.refresh();
+}
+
 std::size_t Simulation::touchingPairs() const {
   std::size_t count = 0;
   for (const auto& h : contacts.sphereSphere.history) count += h.touching;
@@ -360,7 +402,7 @@ void Simulation::saveState(std::ostream& out) const {
   particles.saveState(out);
   put(out, boundary);
   put(out, box);
-  put(out, cell);
+  saveCell(out);
   broadPhase.saveState(out);
   contacts.forEach([&](const auto& list) { list.saveState(out); });
   put(out, model);
@@ -379,7 +421,7 @@ void Simulation::loadState(std::istream& in) {
   particles.loadState(in);
   get(in, boundary);
   get(in, box);
-  get(in, cell);
+  loadCell(in);
   broadPhase.loadState(in);
   contacts.forEach([&](auto& list) { list.loadState(in, particles.size()); });
   get(in, model);

@@ -77,8 +77,8 @@ class Simulation {
   // Exact binary state for checkpoints: a loaded simulation continues bit for bit.
   void saveState(std::ostream& out) const;
   void loadState(std::istream& in);
-  // Checks a loaded state before it is used: sizes consistent, indices in range, finite numbers.
-  // Throws std::runtime_error naming what is wrong.
+  // Consistency of a loaded state before it is stepped (state_validate.cpp): sizes agree, indices
+  // in range, numbers finite. Throws InputError saying what is wrong.
   void validateState() const;
 
  private:
@@ -97,6 +97,8 @@ class Simulation {
   void controlCell();
   void setCellGradient();
   void wrapIntoCell();
+  void saveCell(std::ostream& out) const;
+  void loadCell(std::istream& in);
   bool rebuildDue_ = true;
 };
 

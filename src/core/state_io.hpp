@@ -1,50 +1,195 @@
 #pragma once
 // Exact binary (de)serialisation of the engine state for checkpoints: every double is written as
-// its bytes, so a resumed run continues bit for bit. Only trivially copyable values and vectors of
-// them pass through here; the layout is private to one grainlab version (a version tag guards it).
+// its bytes, so a resumed run continues bit for bit. The layout belongs to one build; the
+// checkpoint container (io/checkpoint_file.hpp) guards it with a format version, a layout tag, the
+// sizes and a checksum.
+//
+// What may be written, checked at compile time for every value:
+//   - arithmetic types and enums, and structs that are trivially copyable (only plain values
+//     inside: a struct holding a std::vector is not trivially copyable and does not compile);
+//   - bool, as one byte that must read back as 0 or 1;
+//   - Eigen's Vec3 and Quat, component by component (they are not trivially copyable);
+//   - contact::ContactHistory, field by field (it holds Vec3s);
+//   - std::array and std::vector of any of these (a vector as a 64-bit count, then the elements).
+// Reading is bounded: loadState reads from a MemoryInput, and every count is checked against the
+// bytes left before anything is allocated.
+#include <array>
 #include <cstdint>
+#include <cstring>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
+#include <streambuf>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
+#include "contact/models.hpp"
+#include "core/types.hpp"
+
 namespace grainlab::stateio {
 
-// Values copied as bytes: trivially copyable types, and the fixed-size Eigen vectors and
-// quaternions (and structs of them), which are plain arrays of doubles with no pointers inside
-// even though their copy constructors are user-provided.
-template <class T>
-constexpr bool kBitwise = std::is_trivially_copyable_v<T> || std::is_standard_layout_v<T>;
+// A malformed state (truncated, a count beyond the bytes left, an invalid value).
+struct StateError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
+// A read-only stream over bytes in memory: the only kind of stream loadState accepts, since the
+// bytes left must be known before a count read from the file is trusted.
+class MemoryInput : public std::istream {
+ public:
+  explicit MemoryInput(std::string_view bytes) : std::istream(&buffer_), buffer_(bytes) {}
+  std::size_t bytesLeft() const { return buffer_.left(); }
+
+ private:
+  struct Buffer : std::streambuf {
+    explicit Buffer(std::string_view b) {
+      char* begin = const_cast<char*>(b.data());  // never written through: get area only
+      setg(begin, begin, begin + b.size());
+    }
+    std::size_t left() const { return static_cast<std::size_t>(egptr() - gptr()); }
+  };
+  Buffer buffer_;
+};
+
+namespace detail {
+inline std::size_t bytesLeft(std::istream& in) {
+  const auto* memory = dynamic_cast<const MemoryInput*>(&in);
+  if (!memory) throw std::logic_error("checkpoint state must be read from a stateio::MemoryInput");
+  return memory->bytesLeft();
+}
+// A MemoryInput cannot read past its end: a short read leaves the stream failed.
+inline void readBytes(std::istream& in, void* to, std::size_t n) {
+  if (!in.read(static_cast<char*>(to), static_cast<std::streamsize>(n))) throw StateError("state truncated");
+}
+}  // namespace detail
+
+// Values written as their bytes: plain values with nothing pointing elsewhere.
 template <class T>
-void put(std::ostream& out, const T& value) {
-  static_assert(kBitwise<T>);
-  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+concept Bytewise = std::is_trivially_copyable_v<T> && !std::is_pointer_v<T> && !std::is_member_pointer_v<T> &&
+                   !std::is_same_v<T, bool>;
+
+// Number of fields of an aggregate (how many initialisers T{...} accepts): lets tests and static
+// assertions notice a field added to a struct whose writer lists its fields by hand.
+namespace detail {
+struct AnyField {
+  template <class U>
+  operator U() const;
+};
+template <class T, class... A>
+constexpr std::size_t fieldCount() {
+  if constexpr (requires { T{A{}..., AnyField{}}; })
+    return fieldCount<T, A..., AnyField>();
+  else
+    return sizeof...(A);
+}
+}  // namespace detail
+template <class T>
+constexpr std::size_t fieldCount() {
+  static_assert(std::is_aggregate_v<T>);
+  return detail::fieldCount<T>();
 }
 
-template <class T>
+template <Bytewise T>
+void put(std::ostream& out, const T& value) {
+  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+template <Bytewise T>
 void get(std::istream& in, T& value) {
-  static_assert(kBitwise<T>);
-  if (!in.read(reinterpret_cast<char*>(&value), sizeof(T))) throw std::runtime_error("checkpoint truncated");
+  detail::readBytes(in, &value, sizeof(T));
+}
+
+inline void put(std::ostream& out, bool value) { put(out, static_cast<std::uint8_t>(value ? 1 : 0)); }
+inline void get(std::istream& in, bool& value) {
+  std::uint8_t b = 0;
+  get(in, b);
+  if (b > 1) throw StateError("state corrupt (a flag is neither 0 nor 1)");
+  value = b == 1;
+}
+
+inline void put(std::ostream& out, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) put(out, v[k]);
+}
+inline void get(std::istream& in, Vec3& v) {
+  for (int k = 0; k < 3; ++k) get(in, v[k]);
+}
+inline void put(std::ostream& out, const Quat& q) {
+  put(out, q.w());
+  put(out, q.x());
+  put(out, q.y());
+  put(out, q.z());
+}
+inline void get(std::istream& in, Quat& q) {
+  double c[4];
+  for (double& v : c) get(in, v);
+  q = Quat(c[0], c[1], c[2], c[3]);
+}
+
+inline void put(std::ostream& out, const Mat3& m) {
+  for (int k = 0; k < 9; ++k) put(out, m(k % 3, k / 3));
+}
+inline void get(std::istream& in, Mat3& m) {
+  for (int k = 0; k < 9; ++k) get(in, m(k % 3, k / 3));
+}
+
+static_assert(fieldCount<contact::ContactHistory>() == 4,
+              "a field was added to ContactHistory: write and read it below");
+inline void put(std::ostream& out, const contact::ContactHistory& h) {
+  put(out, h.shearForce);
+  put(out, h.moment);
+  put(out, h.prevNormal);
+  put(out, h.touching);
+}
+inline void get(std::istream& in, contact::ContactHistory& h) {
+  get(in, h.shearForce);
+  get(in, h.moment);
+  get(in, h.prevNormal);
+  get(in, h.touching);
+}
+
+// Bytes one element occupies in the state (for the bounds check of a vector's count).
+template <class T>
+constexpr std::size_t encodedSize() {
+  if constexpr (std::is_same_v<T, bool>) return 1;
+  else if constexpr (std::is_same_v<T, Vec3>) return 3 * sizeof(double);
+  else if constexpr (std::is_same_v<T, Quat>) return 4 * sizeof(double);
+  else if constexpr (std::is_same_v<T, Mat3>) return 9 * sizeof(double);
+  else if constexpr (std::is_same_v<T, contact::ContactHistory>) return 9 * sizeof(double) + 1;
+  else return sizeof(T);
+}
+
+template <class T, std::size_t N>
+void put(std::ostream& out, const std::array<T, N>& a) {
+  for (const T& v : a) put(out, v);
+}
+template <class T, std::size_t N>
+void get(std::istream& in, std::array<T, N>& a) {
+  for (T& v : a) get(in, v);
 }
 
 template <class T>
 void putVector(std::ostream& out, const std::vector<T>& v) {
   put(out, static_cast<std::uint64_t>(v.size()));
-  if (!v.empty()) out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+  if constexpr (Bytewise<T>) {
+    if (!v.empty()) out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+  } else {
+    for (const T& e : v) put(out, e);
+  }
 }
 
 template <class T>
 void getVector(std::istream& in, std::vector<T>& v) {
-  static_assert(kBitwise<T>);
   std::uint64_t n = 0;
   get(in, n);
-  if (n > (std::uint64_t{1} << 40)) throw std::runtime_error("checkpoint corrupt (vector size)");
-  v.resize(n);
-  if (n && !in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))))
-    throw std::runtime_error("checkpoint truncated");
+  // Before anything is allocated: the count must fit in the bytes that are left.
+  if (n > detail::bytesLeft(in) / encodedSize<T>()) throw StateError("state corrupt (a count exceeds the bytes left)");
+  v.resize(static_cast<std::size_t>(n));
+  if constexpr (Bytewise<T>) {
+    if (n) detail::readBytes(in, v.data(), static_cast<std::size_t>(n) * sizeof(T));
+  } else {
+    for (T& e : v) get(in, e);
+  }
 }
 
 }  // namespace grainlab::stateio

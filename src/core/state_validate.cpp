@@ -2,16 +2,18 @@
 // accidental corruption, these checks catch a file that is well-formed but inconsistent.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "core/errors.hpp"
 #include "core/simulation.hpp"
 
 namespace grainlab {
 
 namespace {
 
-[[noreturn]] void bad(const std::string& what) { throw std::runtime_error("inconsistent state: " + what); }
+[[noreturn]] void bad(const std::string& what) { throw InputError("inconsistent state: " + what); }
 
 template <class T>
 void sameSize(const std::vector<T>& v, std::size_t n, const char* name) {
@@ -55,11 +57,33 @@ void Simulation::validateState() const {
   if (boundary == Boundary::Periodic) {
     if (!cell.h.allFinite() || !(cell.h.determinant() > 0.0)) bad("periodic cell matrix singular or non-finite");
   } else {
+    for (int k = 0; k < 6; ++k) {
+      const Wall& w = box.walls[k];
+      if (w.axis != k / 2 || w.side != k % 2) bad(fmt::format("wall {} has axis {} side {}", k, w.axis, w.side));
+      if (!std::isfinite(w.position) || !std::isfinite(w.velocity) || !std::isfinite(w.servoIntegral))
+        bad(fmt::format("wall {} has a non-finite position or speed", k));
+    }
     for (int a = 0; a < 3; ++a)
       if (!(box.length(a) > 0.0) || !std::isfinite(box.length(a))) bad("wall box with a non-positive length");
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a)
+        if (P.position[i][a] < box.lower(a).position - box.length(a) || P.position[i][a] > box.upper(a).position + box.length(a))
+          bad(fmt::format("particle {} lies far outside the walls", i));
   }
+  // The broad phase's grid has cells of about one largest diameter: a boundary very much larger than
+  // its particles would ask for an absurd grid (a real sample has ~11 cells per particle at e = 20).
+  double rMax = 0.0, rMin = 1e300;
+  for (double r : P.radius) {
+    rMax = std::max(rMax, r);
+    rMin = std::min(rMin, r);
+  }
+  const Vec3 extent = boundary == Boundary::Periodic ? cell.widths()
+                                                     : Vec3(box.length(0), box.length(1), box.length(2));
+  double cells = 1.0;
+  for (int a = 0; a < 3; ++a) cells *= std::max(1.0, extent[a] / (2.0 * rMax));
+  if (cells > 64.0 * static_cast<double>(n) + 1e6) bad("the boundary is far too large for its particles");
   if (!(dt > 0.0) || !std::isfinite(dt)) bad("time step not positive");
-  if (!(broadPhase.skin > 0.0) || !std::isfinite(broadPhase.skin)) bad("neighbour skin not positive");
+  if (!(broadPhase.skin > 0.0) || !(broadPhase.skin <= 2.0 * rMin)) bad(fmt::format("neighbour skin {}", broadPhase.skin));
   if (!broadPhase.positionsAtBuild().empty()) sameSize(broadPhase.positionsAtBuild(), n, "build positions");
   contacts.forEach([&](const auto& list) {
     using Kind = typename std::decay_t<decltype(list)>::KindType;

@@ -6,11 +6,12 @@
 #include <cmath>
 #include <limits>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
+#include "io/install_paths.hpp"
 #include "io/presets.hpp"
 
 namespace grainlab::io {
@@ -19,24 +20,134 @@ using lab::SphericityConfig;
 
 namespace {
 
+// A value as the message echoes it: one line, cut to about 80 characters.
 std::string show(const toml::node& node) {
   std::ostringstream os;
   node.visit([&](const auto& v) { os << v; });
-  return os.str();
+  return printable(os.str());
 }
 
-// A relative path in a config names a file beside that config (for a preset: in presets/), or,
+// The value of a number node. toml++ gives no double for an integer that a double cannot hold
+// exactly (above 2^53), so integers are converted here (to the nearest double).
+double numberOf(const toml::node& node) {
+  if (const auto i = node.value_exact<std::int64_t>()) return static_cast<double>(*i);
+  return node.value<double>().value();
+}
+
+// Nesting of a TOML text (tables of headers and dotted keys, arrays, inline tables), measured
+// before the parser sees it: toml++ and the printer of `check` recurse once per level, so a
+// file nested 100 000 deep would exhaust the stack. The scan follows strings and comments so that
+// brackets and dots inside them do not count.
+void checkNesting(std::string_view text, const std::string& subject) {
+  int line = 1;
+  int base = 0;                  // levels of the current [table] header
+  int depth = 0;                 // levels at this point of the current statement
+  std::vector<std::pair<char, int>> open;  // '[' or '{' of values, with the depth before it
+  bool key = true;               // reading a key (before '=')
+  auto deeper = [&](int d) {
+    if (d > kMaxNesting)
+      throw InputError(fmt::format("{}: line {}: nested deeper than {} levels (tables, arrays, inline tables)", subject,
+                                   line, kMaxNesting));
+  };
+  std::size_t i = 0;
+  const std::size_t n = text.size();
+  auto skipString = [&](char quote) {
+    const bool multi = text.substr(i, 3) == std::string(3, quote);
+    i += multi ? 3 : 1;
+    while (i < n) {
+      const char c = text[i];
+      if (c == '\\' && quote == '"') {
+        i += 2;
+        continue;
+      }
+      if (c == '\n') {
+        ++line;
+        if (!multi) return;  // unterminated: the parser reports it
+      }
+      if (c == quote && (!multi || text.substr(i, 3) == std::string(3, quote))) {
+        i += multi ? 3 : 1;
+        return;
+      }
+      ++i;
+    }
+  };
+  while (i < n) {
+    const char c = text[i];
+    if (c == '"' || c == '\'') {
+      skipString(c);
+      continue;
+    }
+    if (c == '#') {
+      while (i < n && text[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '\n') {
+      ++line;
+      if (open.empty()) {
+        depth = base;
+        key = true;
+      }
+      ++i;
+      continue;
+    }
+    if (c == '[' && open.empty() && key && depth == base) {
+      // A [table] or [[array of tables]] header: one level per dotted part.
+      int levels = 1;
+      if (i + 1 < n && text[i + 1] == '[') ++levels, ++i;
+      ++i;
+      while (i < n && text[i] != ']' && text[i] != '\n') {
+        if (text[i] == '"' || text[i] == '\'') {
+          skipString(text[i]);
+          continue;
+        }
+        if (text[i] == '.') deeper(++levels);
+        ++i;
+      }
+      while (i < n && text[i] == ']') ++i;
+      base = depth = levels;
+      deeper(base);
+      continue;
+    }
+    if (key && c == '.') {
+      deeper(++depth);
+    } else if (key && c == '=') {
+      key = false;
+      deeper(++depth);
+    } else if (c == '[' || c == '{') {
+      open.emplace_back(c, depth);
+      deeper(++depth);
+      key = c == '{';
+    } else if ((c == ']' || c == '}') && !open.empty()) {
+      depth = open.back().second;
+      open.pop_back();
+      key = false;
+    } else if (c == ',' && !open.empty()) {
+      depth = open.back().second + 1;
+      key = open.back().first == '{';
+    }
+    ++i;
+  }
+}
+
+// A relative path in a config names a file beside that config (for a preset: in the installed
+// share/grainlab/presets, io/install_paths.hpp), or,
 // failing that, one relative to the working directory. Resolved paths are absolute, so the
 // resolved config stays valid wherever it is read.
+bool pathExists(const std::filesystem::path& path) {
+  std::error_code ec;  // a name too long or a folder not searchable: not there
+  return std::filesystem::exists(path, ec);
+}
+
 std::string resolvePath(const std::string& path, const std::string& baseDir) {
   namespace fs = std::filesystem;
   if (path.empty() || fs::path(path).is_absolute()) return path;
-  if (!baseDir.empty() && fs::exists(fs::path(baseDir) / path)) return fs::absolute(fs::path(baseDir) / path).string();
-  return fs::exists(path) ? fs::absolute(path).string() : path;
+  if (!baseDir.empty() && pathExists(fs::path(baseDir) / path)) return fs::absolute(fs::path(baseDir) / path).string();
+  return pathExists(path) ? fs::absolute(path).string() : path;
 }
 
+// `value` comes already cut (show, quotedPath); the key may be a user's unknown key.
 [[noreturn]] void fail(const std::string& key, const std::string& value, const std::string& allowed) {
-  throw InputError(fmt::format("config error: {} = {}: {}", key, value, allowed));
+  throw InputError(fmt::format("config error: {} = {}: {}", printable(key), printable(value, 300), allowed));
 }
 
 // One [section] of the config: typed getters with defaults and ranges, and a check that every key
@@ -60,9 +171,9 @@ class Section {
     const toml::node* n = raw(key);
     if (!n) return def;
     if (!n->is_number()) fail(path(key), show(*n), "must be a number; " + allowed);
-    const double v = n->value<double>().value();
-    if (!std::isfinite(v) || (loOpen ? v <= lo : v < lo) || (hiOpen ? v >= hi : v > hi))
-      fail(path(key), show(*n), allowed);
+    const double v = numberOf(*n);
+    if (!std::isfinite(v)) fail(path(key), show(*n), "must be a finite number; " + allowed);
+    if ((loOpen ? v <= lo : v < lo) || (hiOpen ? v >= hi : v > hi)) fail(path(key), show(*n), allowed);
     return v;
   }
   long integer(const std::string& key, long def, long lo, long hi) {
@@ -96,8 +207,8 @@ class Section {
     if (!node.is_array()) fail(key, show(node), "must be an array of numbers");
     std::vector<double> out;
     for (const auto& e : *node.as_array()) {
-      if (!e.is_number()) fail(key, show(node), "must be an array of numbers");
-      out.push_back(e.value<double>().value());
+      if (!e.is_number() || !std::isfinite(numberOf(e))) fail(key, show(node), "must be an array of finite numbers");
+      out.push_back(numberOf(e));
     }
     return out;
   }
@@ -153,15 +264,15 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
     const toml::node* hi = get("d_max");
     if (!lo || !lo->is_number()) fail(key + ".d_min", lo ? show(*lo) : "(missing)", "a diameter > 0 [m] is required");
     if (!hi || !hi->is_number()) fail(key + ".d_max", hi ? show(*hi) : "(missing)", "a diameter >= d_min [m] is required");
-    g.dMin = lo->value<double>().value();
-    g.dMax = hi->value<double>().value();
-    if (!(g.dMin > 0.0)) fail(key + ".d_min", show(*lo), "must be > 0 [m]");
-    if (!(g.dMax >= g.dMin)) fail(key + ".d_max", show(*hi), "must be >= d_min [m]");
+    g.dMin = numberOf(*lo);
+    g.dMax = numberOf(*hi);
+    if (!(g.dMin > 0.0) || !std::isfinite(g.dMin)) fail(key + ".d_min", show(*lo), "must be a finite diameter > 0 [m]");
+    if (!(g.dMax >= g.dMin) || !std::isfinite(g.dMax)) fail(key + ".d_max", show(*hi), "must be a finite diameter >= d_min [m]");
   } else if (g.type == "list") {
     const toml::node* f = get("file");
     if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
     g.file = resolvePath(f->value<std::string>().value(), baseDir);
-    if (!std::filesystem::exists(g.file)) fail(key + ".file", show(*f), "file not found");
+    if (!pathExists(g.file)) fail(key + ".file", show(*f), "file not found");
   } else {
     fail(key + ".type", show(*type), "allowed: \"curve\", \"uniform\", \"list\"");
   }
@@ -171,43 +282,67 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
   return g;
 }
 
+// A string with a NUL character would be cut short where it is used as a path (the C library
+// stops there), so a path could name another file than the one written: refused everywhere.
+void refuseNulCharacters(const toml::node& node, const std::string& key) {
+  if (const auto* t = node.as_table()) {
+    for (const auto& [k, v] : *t) refuseNulCharacters(v, key.empty() ? std::string(k.str()) : key + "." + std::string(k.str()));
+  } else if (const auto* a = node.as_array()) {
+    for (const auto& v : *a) refuseNulCharacters(v, key);
+  } else if (const auto* str = node.as_string()) {
+    if (str->get().find('\0') != std::string::npos) fail(key, show(node), "must not contain a NUL character");
+  }
+}
+
 }  // namespace
 
 std::string configBaseDir(const std::string& source) {
-  if (source.rfind("preset:", 0) == 0) return (std::filesystem::path(GRAINLAB_SOURCE_DIR) / "presets").string();
+  if (source.rfind("preset:", 0) == 0) return presetsDir().string();
   return std::filesystem::absolute(source).parent_path().string();
 }
 
 toml::table loadConfigTable(const std::string& source) {
-  try {
-    if (source.rfind("preset:", 0) == 0) {
-      const std::string name = source.substr(7);
-      const Preset* p = findPreset(name);
-      if (!p) {
-        std::string names;
-        for (const auto& q : presets()) names += (names.empty() ? "" : ", ") + q.name;
-        throw InputError(fmt::format("unknown preset \"{}\"; available: {}", name, names));
-      }
-      return toml::parse(p->toml, "preset:" + name);
+  std::string text, name;
+  if (source.rfind("preset:", 0) == 0) {
+    const std::string preset = source.substr(7);
+    const Preset* p = findPreset(preset);
+    if (!p) {
+      std::string names;
+      for (const auto& q : presets()) names += (names.empty() ? "" : ", ") + q.name;
+      throw InputError(fmt::format("unknown preset \"{}\"; available: {}", printable(preset), names));
     }
-    if (!std::filesystem::exists(source))
-      throw InputError(fmt::format("config file \"{}\" not found", source));
-    return toml::parse_file(source);
+    text = p->toml;
+    name = "preset:" + preset;
+  } else {
+    const std::string subject = fmt::format("config file {}", quotedPath(source));
+    text = readInputFile(source, subject, kMaxConfigBytes);
+    checkNesting(text, subject);
+    name = source;
+  }
+  try {
+    return toml::parse(text, name);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("config error: {} line {}: {}", source, e.source().begin.line,
-                                 e.description()));
+    throw InputError(fmt::format("config error: {} line {}: {}", quotedPath(name), e.source().begin.line,
+                                 printable(e.description(), 160)));
   }
 }
 
 void applyOverride(toml::table& table, const std::string& assignment) {
+  const std::string shown = printable(assignment);
+  if (assignment.size() > kMaxConfigBytes)
+    throw InputError(fmt::format("--set {}: longer than the limit of {} bytes", shown, kMaxConfigBytes));
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw InputError(fmt::format("--set {}: expected KEY=VALUE with a dotted key, e.g. contact.beta=0", assignment));
+    throw InputError(fmt::format("--set {}: expected KEY=VALUE with a dotted key, e.g. contact.beta=0", shown));
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
+  if (std::count(key.begin(), key.end(), '.') >= kMaxNesting)
+    throw InputError(fmt::format("--set {}: the key is nested deeper than {} levels", shown, kMaxNesting));
+  const std::string document = "v = " + value;
+  checkNesting(document, fmt::format("--set {}", shown));
   toml::table parsed;
   try {
-    parsed = toml::parse("v = " + value);
+    parsed = toml::parse(document);
   } catch (const toml::parse_error&) {
     // A bare word (e.g. model=rolling-linear) is meant as a string.
     toml::table t;
@@ -219,7 +354,7 @@ void applyOverride(toml::table& table, const std::string& assignment) {
   while (true) {
     const auto dot = key.find('.', start);
     const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (part.empty()) throw InputError(fmt::format("--set {}: empty component in key \"{}\"", assignment, key));
+    if (part.empty()) throw InputError(fmt::format("--set {}: empty component in key \"{}\"", shown, printable(key)));
     if (dot == std::string::npos) {
       cur->insert_or_assign(part, *parsed.get("v"));
       return;
@@ -230,10 +365,20 @@ void applyOverride(toml::table& table, const std::string& assignment) {
       next = cur->get(part);
     }
     if (!next->is_table())
-      throw InputError(fmt::format("--set {}: \"{}\" is not a table", assignment, key.substr(0, dot)));
+      throw InputError(fmt::format("--set {}: \"{}\" is not a table", shown, printable(key.substr(0, dot))));
     cur = next->as_table();
     start = dot + 1;
   }
+}
+
+void setOutputDir(toml::table& table, const std::string& dir) {
+  toml::node* output = table.get("output");
+  if (!output) {
+    table.insert("output", toml::table{});
+    output = table.get("output");
+  }
+  if (!output->is_table()) throw InputError(fmt::format("config error: output = {}: must be a table", show(*output)));
+  output->as_table()->insert_or_assign("dir", dir);
 }
 
 lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) {
@@ -243,12 +388,13 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     if (std::find(sections.begin(), sections.end(), key) == sections.end())
       fail(key, show(v), "unknown section; allowed: [sample], [contact], [test], [solver], [output]");
   }
+  refuseNulCharacters(root, "");
   lab::RunConfig c;
 
   Section s(root, "sample");
   c.sample.nParticles = static_cast<int>(s.integer("n_particles", c.sample.nParticles, 2, 50'000'000));
   c.sample.grading = parseGrading(s, baseDir);
-  c.sample.density = s.number("density", c.sample.density, 0.0, 1e6, true, false, "must be > 0 [kg/m^3]");
+  c.sample.density = s.number("density", c.sample.density, 0.0, 1e6, true, false, "must be in (0, 1e6] [kg/m^3]");
   c.sample.e0 = s.number("e0", c.sample.e0, 0.0, 5.0, true, false, "must be > 0 and <= 5 (void ratio)");
   c.sample.seed = static_cast<std::uint64_t>(s.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
   if (const toml::node* n = s.raw("prep_friction_deg")) {
@@ -263,8 +409,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
                                        "must be in [1, 20] (loose placement before compaction)");
   c.sample.packing = resolvePath(s.string("packing", c.sample.packing, {}), baseDir);
-  if (!c.sample.packing.empty() && !std::filesystem::exists(c.sample.packing))
-    fail("sample.packing", "\"" + c.sample.packing + "\"", "file not found");
+  if (!c.sample.packing.empty() && !pathExists(c.sample.packing))
+    fail("sample.packing", quotedPath(c.sample.packing), "file not found");
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
@@ -305,15 +451,16 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     const toml::node* file = t.get("file");
     if (!file || !file->is_string()) fail(key + ".file", file ? show(*file) : "(missing)", "a path to a CSV of sphericities is required");
     sc.file = resolvePath(file->value<std::string>().value(), baseDir);
-    if (!std::filesystem::exists(sc.file)) fail(key + ".file", show(*file), "file not found");
+    if (!pathExists(sc.file)) fail(key + ".file", show(*file), "file not found");
     if (const toml::node* cn = t.get("c")) {
-      if (!cn->is_number() || !(cn->value<double>().value() > 0.0)) fail(key + ".c", show(*cn), "must be a number > 0");
-      sc.c = cn->value<double>().value();
+      if (!cn->is_number() || !(numberOf(*cn) > 0.0) || !std::isfinite(numberOf(*cn)))
+        fail(key + ".c", show(*cn), "must be a finite number > 0");
+      sc.c = numberOf(*cn);
     }
     const toml::node* kn = t.get("k");
     if (!kn) fail(key + ".k", "(missing)", "the exponent k of mu_r = c psi^k has no default and must be given");
-    if (!kn->is_number() || !std::isfinite(kn->value<double>().value())) fail(key + ".k", show(*kn), "must be a number");
-    sc.k = kn->value<double>().value();
+    if (!kn->is_number() || !std::isfinite(numberOf(*kn))) fail(key + ".k", show(*kn), "must be a finite number");
+    sc.k = numberOf(*kn);
     if (const toml::node* cb = t.get("combine")) {
       const std::string v = cb->is_string() ? cb->value<std::string>().value() : "";
       if (v != "min" && v != "mean" && v != "harmonic") fail(key + ".combine", show(*cb), "allowed: \"min\", \"mean\", \"harmonic\"");

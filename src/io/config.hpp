@@ -7,12 +7,16 @@
 
 namespace grainlab::io {
 
-// Reads a config file, or a shipped preset when `source` is "preset:NAME".
+// Reads a config file, or a shipped preset when `source` is "preset:NAME". A file must be a regular
+// file within kMaxConfigBytes and nested at most kMaxNesting deep (io/input_file.hpp).
 toml::table loadConfigTable(const std::string& source);
-// Applies one `--set KEY=VALUE` (dotted key, TOML value; a bare word is taken as a string).
+// Applies one `--set KEY=VALUE` (dotted key, TOML value; a bare word is taken as a string), within
+// the same size and nesting limits as a file.
 void applyOverride(toml::table& table, const std::string& assignment);
+// Sets output.dir to exactly these bytes (for --out: never parsed as TOML).
+void setOutputDir(toml::table& table, const std::string& dir);
 // The folder relative file paths of a config are resolved against: the config file's own, or
-// presets/ for a preset.
+// share/grainlab/presets for a preset (io/install_paths.hpp).
 std::string configBaseDir(const std::string& source);
 // Validates every key (unknown keys, types, ranges) and returns the run description.
 // Throws InputError with a one-line message naming the key, the value and what is allowed.

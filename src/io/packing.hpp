@@ -1,20 +1,70 @@
 #pragma once
-// Packing files: a prepared sample (walls and spheres) that a run can start from, that the bench
-// caches, and that peer programs (bench/peer/yade_triaxial.py) read.
+// Packing files: a prepared sample that a run can start from (sample.packing), that every run
+// saves (packing.txt), that the bench caches and that peer programs read (bench/peer/yade_scene.py).
 //
-//   # free comment line
-//   xlo xhi ylo yhi zlo zhi        wall planes [m]
-//   radius x y z                   one sphere per line [m]
+// Version 2 (written by grainlab; README "Packing files"):
+//
+//   # grainlab-packing 2
+//   # program grainlab <version>
+//   # comment <free text, one line>
+//   # boundary walls                               (or: periodic)
+//   # walls xlo xhi ylo yhi zlo zhi                (boundary walls) [m]
+//   # cell h11 h12 h13 h21 h22 h23 h31 h32 h33     (boundary periodic) row-major H, columns = cell
+//                                                  edge vectors, origin 0 [m]
+//   # particles N
+//   # columns id shape a b c x y z qw qx qy qz
+//   # xxh64 <16 hex digits: xxh64 (seed 0) of every byte after this line>
+//   N rows: id (unsigned integer, unique), shape (sphere|ellipsoid), semi-axes a >= b >= c > 0 [m]
+//   (sphere: a = b = c = radius), centre x y z [m], orientation quaternion qw qx qy qz (unit within
+//   1e-6; identity for spheres, whose orientation is not used)
+//
+// Every header line is required except xxh64: a file written by hand without it is accepted after
+// every other check (grainlab always writes it). The lines after the first may come in any order,
+// but xxh64 must be the last. The checksum covers the rows only, so the free text of `program` and
+// `comment` and the numbers of `walls`/`cell` are checked for form, not for integrity. Version 1 (grainlab 0.1: a
+// comment line, a line of six wall positions, then `radius x y z` rows) stays readable.
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/simulation.hpp"
 
 namespace grainlab::io {
 
-std::string packingText(const Simulation& sim, const std::string& comment);
-// Replaces the particles and walls of `sim`; throws InputError naming the file and line on bad
-// content.
-void loadPacking(const std::filesystem::path& file, double density, Simulation& sim);
+struct PackedParticle {
+  std::uint64_t id = 0;
+  bool ellipsoid = false;
+  Vec3 semiAxes = Vec3::Zero();  // a >= b >= c [m]
+  Vec3 position = Vec3::Zero();  // [m]
+  Quat orientation = Quat::Identity();
+};
+
+struct PackingData {
+  int version = 2;         // of the file it was read from
+  std::string program;     // "grainlab 0.1.0" (version 2 only)
+  std::string comment;
+  bool periodic = false;
+  std::array<double, 6> walls{};  // xlo xhi ylo yhi zlo zhi [m] (walls)
+  Mat3 cell = Mat3::Identity();   // columns = cell edge vectors [m] (periodic)
+  std::vector<PackedParticle> particles;
+};
+
+// Version 2 text, checksum included.
+std::string packingText(const PackingData& packing);
+// Reads a packing file of version 1 or 2: a regular file of at most kMaxPackingBytes, every header
+// key, count, number and the checksum validated. Throws InputError
+// `config error: <key> = "<file>": line N: <what>` (key: the config key that named the file).
+PackingData readPackingFile(const std::filesystem::path& file, const std::string& key);
+// The same for text in memory; `subject` starts every message.
+PackingData parsePacking(std::string_view text, const std::string& subject);
+
+// The spheres and walls of a simulation (ids = particle indices).
+PackingData packingFromSimulation(const Simulation& sim, const std::string& comment);
+// Replaces the particles and walls of `sim`. This build simulates spheres between walls only: an
+// ellipsoid or a periodic cell is an InputError naming `subject`.
+void simulationFromPacking(const PackingData& packing, double density, Simulation& sim, const std::string& subject);
 
 }  // namespace grainlab::io

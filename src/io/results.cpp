@@ -1,27 +1,43 @@
 #include "io/results.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace grainlab::io {
 
+void createDirectories(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw FileError(fileErrorMessage("cannot create the folder", dir, ec.value()));
+}
+
 void writeFileAtomic(const std::filesystem::path& path, const std::string& content) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  if (path.has_parent_path()) createDirectories(path.parent_path());
   const std::filesystem::path tmp = path.string() + fmt::format(".tmp{}", ::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(fmt::format("cannot write {}", tmp.string()));
-    out << content;
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("error writing {}", tmp.string()));
+  auto failWith = [&](int err, int fd) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw FileError(fileErrorMessage("cannot write", path, err));
+  };
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw FileError(fileErrorMessage("cannot write", path, errno));
+  std::size_t done = 0;
+  while (done < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) failWith(errno, fd);
+    done += static_cast<std::size_t>(n);
   }
-  std::filesystem::rename(tmp, path);
+  if (::close(fd) != 0) failWith(errno, -1);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) failWith(errno, -1);
 }
 
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {

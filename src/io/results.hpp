@@ -8,7 +8,11 @@
 
 namespace grainlab::io {
 
+// Writes `content` to `path` through a temporary file beside it (removed again on any failure).
+// Throws FileError naming the path and the system's reason.
 void writeFileAtomic(const std::filesystem::path& path, const std::string& content);
+// create_directories that throws FileError naming the folder and the system's reason.
+void createDirectories(const std::filesystem::path& dir);
 
 // Columns beyond the common ones that a test writes: the periodic cell's (eps1_log,
 // stress_skew), simple shear's (gamma, tau) and true triaxial's (b).

@@ -4,44 +4,56 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
+#include <charconv>
+#include <optional>
+#include <string_view>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace grainlab::lab {
 
 namespace {
 
-std::vector<double> readDiameterList(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("config error: sample.grading.file = \"{}\": cannot be read", path));
-  std::vector<double> out;
-  std::string line;
-  int lineNo = 0;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    const auto comma = line.find(',');
-    std::string field = line.substr(0, comma);
-    field.erase(0, field.find_first_not_of(" \t"));
-    if (field.empty() || field[0] == '#') continue;
-    try {
-      std::size_t used = 0;
-      const double d = std::stod(field, &used);
-      if (!(d > 0.0) || !std::isfinite(d)) throw std::invalid_argument("");
-      out.push_back(d);
-    } catch (const std::exception&) {
-      if (lineNo == 1) continue;  // a header row
-      throw InputError(fmt::format("config error: sample.grading.file = \"{}\": line {} \"{}\" is not a diameter > 0 [m]",
-                                   path, lineNo, line));
-    }
-  }
-  if (out.empty())
-    throw InputError(fmt::format("config error: sample.grading.file = \"{}\": no diameters found", path));
-  return out;
+// A number in a list file: the whole field (an optional '+' aside) must be one, and finite.
+std::optional<double> listNumber(std::string_view field, bool& numeric) {
+  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
+  numeric = !field.empty() && end == field.data() + field.size() &&
+            (ec == std::errc() || ec == std::errc::result_out_of_range);
+  if (!numeric || ec != std::errc() || !std::isfinite(v)) return std::nullopt;
+  return v;
 }
 
 }  // namespace
+
+std::vector<double> readDiameterList(const std::string& path) {
+  const std::string subject = fmt::format("config error: sample.grading.file = {}", io::quotedPath(path));
+  const std::string text = io::readInputFile(path, subject, io::kMaxListFileBytes);
+  std::vector<double> out;
+  std::size_t pos = 0;
+  int lineNo = 0;
+  while (pos < text.size()) {
+    const std::size_t nl = std::min(text.find('\n', pos), text.size());
+    const std::string_view line(text.data() + pos, nl - pos);
+    pos = nl + 1;
+    ++lineNo;
+    std::string_view field = line.substr(0, line.find(','));
+    const auto b = field.find_first_not_of(" \t\r");
+    if (b == std::string_view::npos || field[b] == '#') continue;
+    field = field.substr(b, field.find_last_not_of(" \t\r") - b + 1);
+    bool numeric = false;
+    const std::optional<double> d = listNumber(field, numeric);
+    if (!numeric && lineNo == 1) continue;  // a header row
+    if (!d || !(*d > 0.0))
+      throw InputError(fmt::format("{}: line {}: \"{}\" is not a finite diameter > 0 [m]", subject, lineNo,
+                                   io::printable(field)));
+    out.push_back(*d);
+  }
+  if (out.empty()) throw InputError(fmt::format("{}: no diameters found", subject));
+  return out;
+}
 
 std::vector<double> sampleDiameters(const GradingConfig& g, int n, Rng& rng) {
   std::vector<double> d(n);

@@ -1,6 +1,7 @@
 #pragma once
 // Particle size distributions (LAB.md test 1): a sieve curve (percent passing by mass), a range
 // uniform by number, or a list of diameters.
+#include <string>
 #include <vector>
 
 #include "lab/random.hpp"
@@ -12,6 +13,11 @@ namespace grainlab::lab {
 // (piecewise-linear passing curve), so the number density there is proportional to d^-3; it is
 // sampled exactly by inverting its cumulative distribution.
 std::vector<double> sampleDiameters(const GradingConfig& grading, int n, Rng& rng);
+
+// The diameters [m] of a list file (sample.grading type "list"): one per line, the first field of a
+// CSV row; an optional header row and '#' comments. Every value must be a finite number > 0; throws
+// InputError naming the file and line. The file is read within io::kMaxListFileBytes.
+std::vector<double> readDiameterList(const std::string& path);
 
 // Characteristic diameters of a set of spheres, by mass (as a sieve analysis would give).
 struct GradingStats {

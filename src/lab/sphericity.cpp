@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
 #include <numeric>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace grainlab::lab {
 
@@ -27,12 +27,11 @@ std::vector<std::string> splitCsv(const std::string& line) {
 }  // namespace
 
 SphericityDistribution readSphericityFile(const std::string& path, const std::string& key) {
-  std::ifstream in(path);
+  const std::string subject = fmt::format("config error: {} = {}", key, io::quotedPath(path));
+  std::istringstream in(io::readInputFile(path, subject, io::kMaxListFileBytes));
   auto fail = [&](int line, const std::string& what) {
-    return InputError(fmt::format("config error: {} = \"{}\": {}{}", key, path,
-                                  line > 0 ? fmt::format("line {}: ", line) : std::string(), what));
+    return InputError(fmt::format("{}: {}{}", subject, line > 0 ? fmt::format("line {}: ", line) : std::string(), what));
   };
-  if (!in) throw fail(0, "cannot be read");
   std::string line;
   int lineNo = 0;
   std::vector<std::string> header;
@@ -61,7 +60,7 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
         if (used != f[col].size() || !std::isfinite(v)) throw std::invalid_argument("");
         return v;
       } catch (const std::exception&) {
-        throw fail(lineNo, fmt::format("{} \"{}\" is not a number", name, f[col]));
+        throw fail(lineNo, fmt::format("{} \"{}\" is not a finite number", name, io::printable(f[col])));
       }
     };
     if (psiCol >= 0) {

@@ -153,7 +153,9 @@ def test_packing_round_trip(grainlab, tmp_path):
     grainlab("run", write(tmp_path, cfg), "--out", str(first), "--quiet", "--set", "output.plots=false", check=0)
     packing = first / "packing.txt"
     lines = packing.read_text().splitlines()
-    assert lines[0].startswith("#") and len(lines[1].split()) == 6 and len(lines) == 2 + 80
+    # Format version 2 (io/packing.hpp): header lines, then one row per sphere.
+    assert lines[0] == "# grainlab-packing 2" and "# particles 80" in lines
+    assert len([l for l in lines if not l.startswith("#")]) == 80
     second = tmp_path / "second"
     grainlab("run", write(tmp_path, cfg), "--out", str(second), "--quiet", "--set", "output.plots=false",
              "--set", f'sample.packing="{packing}"', check=0)

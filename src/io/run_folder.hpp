@@ -1,0 +1,47 @@
+#pragma once
+// The results folder of a run, and how new results replace earlier ones (README "Results folder").
+//
+//   - A new or empty folder: the run writes into it directly; there is nothing earlier to protect.
+//   - A folder holding earlier grainlab results (it has a config.resolved.toml): the run writes into
+//     the hidden sibling .NAME.grainlab-new and, only once it has completed, exchanges the two
+//     atomically (renameat2 RENAME_EXCHANGE) and deletes the earlier results. A refused, failed or
+//     killed re-run leaves NAME exactly as it was; `grainlab resume NAME` continues a killed re-run
+//     from its sibling, and the next `run` into NAME discards it.
+//   - Any other non-empty folder is refused: grainlab replaces only its own results.
+//
+// A symbolic link as the folder is followed (the results replace its target's contents).
+#include <filesystem>
+
+namespace grainlab::io {
+
+class RunFolder {
+ public:
+  // Prepares the folder of a new run into `requested` (creates what is needed). Throws InputError
+  // for a folder grainlab must not replace, FileError for a file-system failure.
+  static RunFolder forRun(const std::filesystem::path& requested);
+  // The InputError forRun would throw for `requested` (a non-empty folder that is not grainlab's),
+  // checked without creating anything (for `check`).
+  static void checkReplaceable(const std::filesystem::path& requested);
+  // The folder a `resume` of `requested` continues in: the staging sibling of a killed re-run when
+  // there is one with a checkpoint, else the folder itself.
+  static RunFolder forResume(const std::filesystem::path& requested);
+
+  const std::filesystem::path& work() const { return work_; }      // where the run writes
+  const std::filesystem::path& target() const { return target_; }  // where the results end up
+  bool staged() const { return work_ != target_; }
+
+  // Puts the completed results in place (a no-op when the run wrote there directly).
+  void commit();
+  // Removes what this run created (after a refused input, or a re-run that failed); a folder that
+  // existed and was empty is emptied again; a resumed run in place is left alone.
+  void discard();
+
+  // .NAME.grainlab-new beside NAME.
+  static std::filesystem::path stagingFolderOf(const std::filesystem::path& target);
+
+ private:
+  std::filesystem::path target_, work_;
+  enum class Origin { Created, WasEmpty, Staged, Resumed } origin_ = Origin::Created;
+};
+
+}  // namespace grainlab::io

@@ -1,0 +1,350 @@
+// Checkpoint state (core/state_io.hpp, Simulation::validateState): a saved and reloaded laboratory
+// continues bit for bit; a truncated or inconsistent state is an error, never a crash; and adding a
+// field to a checkpointed struct without teaching the writer fails to compile here.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstring>
+#include <functional>
+#include <optional>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/state_io.hpp"
+#include "lab/protocols.hpp"
+
+using namespace grainlab;
+
+namespace {
+
+// Size of a struct holding these members in this order (each at its alignment, the whole rounded
+// up to the largest alignment): what sizeof gives when the listed members are all there is.
+template <class... Members>
+constexpr std::size_t layoutSize() {
+  std::size_t offset = 0, align = 1;
+  ((offset = (offset + alignof(Members) - 1) / alignof(Members) * alignof(Members) + sizeof(Members),
+    align = std::max(align, alignof(Members))),
+   ...);
+  return (offset + align - 1) / align * align;
+}
+
+// The members of Laboratory's private ShearState, in order (lab/protocols.hpp).
+struct ShearStateMembers {
+  bool started;
+  double h0, v0;
+  Vec3 l0;
+  double loadingSpeed;
+  long rampSteps, startStep;
+  double nextRecord, nextSnapshot, nextCheckpoint;
+  Vec3 stressSum;
+  double shearStressSum;
+  std::array<double, 6> wallStressSum;
+  long stressSamples;
+  double elastic0, kinetic0;
+  lab::ShearResult result;
+};
+
+}  // namespace
+
+// The structs whose saveState/loadState list their fields by hand. A failure here means a field was
+// added (or removed): write and read it in saveState/loadState (or derive it on load, as invMass
+// is), then update the list below. Trivially copyable structs (Wall, Record, ...) are written whole
+// and need no list; the checkpoint's layout tag (io/checkpoint_file.cpp) changes with their size.
+static_assert(stateio::fieldCount<Particles>() == 16,
+              "Particles changed: update Particles::saveState/loadState and this count (14 saved + invMass, invInertia)");
+static_assert(stateio::fieldCount<contact::ContactHistory>() == 4, "ContactHistory changed: update state_io.hpp");
+static_assert(sizeof(BroadPhase) ==
+                  layoutSize<double, long, std::vector<Vec3>, std::array<double, 6>, Mat3, SpatialGrid>(),
+              "BroadPhase changed: update BroadPhase::saveState/loadState and this list (the grid is scratch)");
+static_assert(sizeof(ContactList<SphereSphere>) ==
+                  layoutSize<std::vector<std::uint32_t>, std::vector<std::uint32_t>, std::vector<std::uint32_t>,
+                             std::vector<contact::ContactHistory>, std::vector<Vec3>, std::vector<Vec3>,
+                             std::vector<Vec3>, std::vector<std::uint32_t>, std::vector<std::uint32_t>, bool>(),
+              "ContactList changed: update ContactList::saveState/loadState and this list (the CSR is derived)");
+static_assert(sizeof(ContactStore) == layoutSize<ContactList<SphereSphere>, ContactList<SpherePlane>>(),
+              "ContactStore changed: its kinds are saved through forEach; update this list");
+static_assert(stateio::fieldCount<PeriodicCell>() == 16, "PeriodicCell changed: update Simulation::saveCell/loadCell");
+static_assert(stateio::fieldCount<lab::GrainRecords>() == 5, "GrainRecords changed: update its saveState/loadState");
+static_assert(sizeof(Simulation) ==
+                  layoutSize<Particles, Boundary, WallBox, PeriodicCell, ContactStore, BroadPhase,
+                             contact::SphereContactModel, ServoSettings, EnergyLedger, Vec3, double, double, long,
+                             double, bool>(),
+              "Simulation changed: update Simulation::saveState/loadState and this list");
+static_assert(sizeof(lab::Laboratory) ==
+                  layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
+                             ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
+                             lab::MicroColumnSet, double>(),
+              "Laboratory changed: update Laboratory::saveState/loadState and this list");
+static_assert(std::is_trivially_copyable_v<Wall> && std::is_trivially_copyable_v<lab::Record> &&
+              std::is_trivially_copyable_v<contact::SphereContactModel>);
+
+// The writer refuses what it cannot write exactly: Eigen types are not bytewise (written by
+// components), nor is a struct holding a vector (its heap pointer would be written).
+static_assert(!stateio::Bytewise<Vec3> && !stateio::Bytewise<Quat> && !stateio::Bytewise<lab::ShearResult>);
+static_assert(!stateio::Bytewise<bool> && !stateio::Bytewise<double*>);
+static_assert(stateio::Bytewise<Wall> && stateio::Bytewise<lab::Record>);
+
+namespace {
+
+lab::RunConfig smallConfig() {
+  lab::RunConfig c;
+  c.sample.nParticles = 40;
+  c.sample.grading.type = "uniform";
+  c.sample.grading.dMin = 4e-3;
+  c.sample.grading.dMax = 6e-3;
+  c.sample.prepFrictionDeg = 0.0;
+  c.sample.seed = 5;
+  c.test.finalAxialStrain = 0.003;
+  c.test.axialStrainRate = 1.0;
+  return c;
+}
+
+std::string saved(const lab::Laboratory& lab) {
+  std::ostringstream out(std::ios::binary);
+  lab.saveState(out);
+  return out.str();
+}
+
+// A laboratory a little way into shearing, and its state then.
+struct Sheared {
+  lab::Laboratory lab{smallConfig()};
+  std::string state;
+  Sheared() {
+    // One thread: every test binary under ctest builds this again, and OpenMP threads on a busy
+    // 2-core machine slow down many times over.
+    omp_set_num_threads(1);
+    lab.prepare();
+    lab.beginShear();
+    for (int i = 0; i < 300; ++i) lab.simulation().step();
+    state = saved(lab);
+  }
+};
+
+Sheared& sheared() {
+  static Sheared s;
+  return s;
+}
+
+}  // namespace
+
+TEST(StateIo, ReloadedLaboratoryContinuesBitForBit) {
+  Sheared& s = sheared();
+  lab::Laboratory copy(smallConfig());
+  stateio::MemoryInput in(s.state);
+  copy.loadState(in);
+  EXPECT_EQ(in.bytesLeft(), 0u);
+  copy.simulation().validateState();
+  EXPECT_EQ(saved(copy), s.state);  // everything read is written back identically
+
+  lab::Laboratory original(smallConfig());
+  stateio::MemoryInput again(s.state);
+  original.loadState(again);
+  const lab::ShearResult a = original.continueShear();
+  const lab::ShearResult b = copy.continueShear();
+  ASSERT_EQ(a.records.size(), b.records.size());
+  ASSERT_GT(a.records.size(), 2u);
+  EXPECT_EQ(std::memcmp(a.records.data(), b.records.data(), a.records.size() * sizeof(lab::Record)), 0);
+  const Particles& pa = original.simulation().particles;
+  const Particles& pb = copy.simulation().particles;
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    EXPECT_EQ(pa.position[i], pb.position[i]);
+    EXPECT_EQ(pa.orientation[i].coeffs(), pb.orientation[i].coeffs());
+  }
+}
+
+TEST(StateIo, EveryTruncationIsAnErrorNeverACrash) {
+  const std::string& state = sheared().state;
+  // Every cut in the first 4 kB (the headers of the arrays), then a spread over the rest.
+  std::vector<std::size_t> cuts;
+  for (std::size_t n = 0; n < std::min<std::size_t>(4096, state.size()); ++n) cuts.push_back(n);
+  for (std::size_t n = 4096; n < state.size(); n += state.size() / 97 + 1) cuts.push_back(n);
+  for (std::size_t n : cuts) {
+    lab::Laboratory lab(smallConfig());
+    stateio::MemoryInput in(std::string_view(state).substr(0, n));
+    EXPECT_THROW(lab.loadState(in), stateio::StateError) << "cut at " << n << " of " << state.size();
+  }
+}
+
+TEST(StateIo, ACountBeyondTheBytesLeftIsRefusedBeforeAllocating) {
+  std::string state = sheared().state;
+  // The first value is the count of particle positions: make it 2^62 (1.5e20 bytes of Vec3).
+  const std::uint64_t huge = std::uint64_t{1} << 62;
+  std::memcpy(state.data(), &huge, sizeof(huge));
+  lab::Laboratory lab(smallConfig());
+  stateio::MemoryInput in(state);
+  try {
+    lab.loadState(in);
+    FAIL() << "accepted";
+  } catch (const stateio::StateError& e) {
+    EXPECT_NE(std::string(e.what()).find("count exceeds the bytes left"), std::string::npos) << e.what();
+  }
+}
+
+TEST(StateIo, AFlagThatIsNeitherZeroNorOneIsRefused) {
+  std::ostringstream out(std::ios::binary);
+  stateio::put(out, std::uint8_t{2});
+  const std::string bytes = out.str();
+  stateio::MemoryInput in(bytes);
+  bool flag = false;
+  EXPECT_THROW(stateio::get(in, flag), stateio::StateError);
+}
+
+TEST(StateIo, OnlyAMemoryInputIsAccepted) {
+  std::istringstream in(sheared().state);
+  std::vector<double> v;
+  EXPECT_THROW(stateio::getVector(in, v), std::logic_error);
+}
+
+TEST(StateIo, VectorsOfEigenTypesAreWrittenByComponents) {
+  const std::vector<Vec3> v{Vec3(1.0, -2.5, 3.25), Vec3(0.1, 0.2, 0.3)};
+  const std::vector<Quat> q{Quat(0.5, 0.5, -0.5, 0.5)};
+  std::ostringstream out(std::ios::binary);
+  stateio::putVector(out, v);
+  stateio::putVector(out, q);
+  const std::string bytes = out.str();
+  ASSERT_EQ(bytes.size(), 8 + 2 * 24 + 8 + 32u);
+  double third;  // the third double of the first vector: z of v[0]
+  std::memcpy(&third, bytes.data() + 8 + 16, sizeof(double));
+  EXPECT_EQ(third, 3.25);
+  double w;  // a quaternion is written w, x, y, z
+  std::memcpy(&w, bytes.data() + 8 + 48 + 8, sizeof(double));
+  EXPECT_EQ(w, 0.5);
+  stateio::MemoryInput in(bytes);
+  std::vector<Vec3> v2;
+  std::vector<Quat> q2;
+  stateio::getVector(in, v2);
+  stateio::getVector(in, q2);
+  EXPECT_EQ(v2, v);
+  EXPECT_EQ(q2[0].coeffs(), q[0].coeffs());
+}
+
+namespace {
+
+// Loads the sheared state, lets `spoil` change it, and returns validateState's complaint ("" if none).
+std::string complaint(const std::function<void(Simulation&)>& spoil) {
+  lab::Laboratory lab(smallConfig());
+  stateio::MemoryInput in(sheared().state);
+  lab.loadState(in);
+  spoil(lab.simulation());
+  try {
+    lab.simulation().validateState();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(ValidateState, AcceptsASavedStateAndNamesWhatIsInconsistent) {
+  EXPECT_EQ(complaint([](Simulation&) {}), "");
+  EXPECT_NE(complaint([](Simulation& s) {
+              s.contacts.sphereSphere.b[0] = static_cast<std::uint32_t>(s.particles.size());
+            }).find("sphere-sphere contact 0"),
+            std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.particles.position[3][1] = std::nan(""); }).find("particle 3"),
+            std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.particles.radius.pop_back(); }).find("entries"), std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { std::swap(s.contacts.sphereSphere.b[0], s.contacts.sphereSphere.b[1]); })
+                .find("not sorted"),
+            std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.contacts.sphereWall.b.assign(s.contacts.sphereWall.size(), 6); })
+                .find("sphere-wall"),
+            std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.particles.mass[0] = 0.0; }).find("particle 0"), std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.dt = -1.0; }).find("time step"), std::string::npos);
+  EXPECT_NE(complaint([](Simulation& s) { s.box.upper(0).position = 1e6; }).find("far too large"), std::string::npos);
+}
+
+// --- the checkpoint container (io/checkpoint_file.hpp) ---------------------------------------------
+
+#include <xxhash.h>
+
+#include "io/checkpoint_file.hpp"
+
+namespace {
+
+const nlohmann::json kRecord{{"summary", {{"e0", 0.61}}}, {"vtk_labels", {0.0, 0.01}}, {"wall_seconds", 1.5}};
+
+// Rewrites a header field of an encoded checkpoint and recomputes its checksum, as a deliberate
+// forgery (or another program) would.
+std::string withField(std::string bytes, std::size_t offset, const void* value, std::size_t size) {
+  std::memcpy(bytes.data() + offset, value, size);
+  const std::uint64_t sum = XXH64(bytes.data(), bytes.size() - 8, 0);
+  std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
+  return bytes;
+}
+
+std::string withVersion(const std::string& bytes, const std::string& version) {
+  char field[32] = {};
+  std::memcpy(field, version.data(), version.size());
+  return withField(bytes, 32, field, sizeof(field));
+}
+
+std::string refusal(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(CheckpointFile, RoundTrip) {
+  const lab::RunConfig config = smallConfig();
+  const std::string state = "engine state \x01\x02\x03";
+  const io::Checkpoint c = io::decodeCheckpoint(io::encodeCheckpoint(config, kRecord, state), "state.bin");
+  EXPECT_EQ(c.state, state);
+  EXPECT_EQ(c.record, kRecord);
+  EXPECT_EQ(c.programVersion, GRAINLAB_VERSION);
+  EXPECT_NO_THROW(io::checkCheckpointBelongs(c, "state.bin", config, false));
+}
+
+TEST(CheckpointFile, EveryBitFlipAndEveryTruncationIsRefused) {
+  const std::string good = io::encodeCheckpoint(smallConfig(), kRecord, std::string(200, '\x5a'));
+  for (std::size_t byte = 0; byte < good.size(); ++byte)
+    for (int bit = 0; bit < 8; ++bit) {
+      std::string bad = good;
+      bad[byte] = static_cast<char>(bad[byte] ^ (1 << bit));
+      const std::string why = refusal([&] { io::decodeCheckpoint(bad, "dir/state.bin"); });
+      ASSERT_NE(why.find("dir/state.bin"), std::string::npos) << "flip of bit " << bit << " of byte " << byte;
+    }
+  for (std::size_t n = 0; n < good.size(); ++n)
+    ASSERT_NE(refusal([&] { io::decodeCheckpoint(good.substr(0, n), "state.bin"); }), "") << "cut at " << n;
+}
+
+TEST(CheckpointFile, VersionLayoutAndConfigMustMatch) {
+  const lab::RunConfig config = smallConfig();
+  const std::string good = io::encodeCheckpoint(config, kRecord, "x");
+  auto belongs = [&](const std::string& bytes, const lab::RunConfig& c, bool allowOlder) {
+    return refusal([&] { io::checkCheckpointBelongs(io::decodeCheckpoint(bytes, "s.bin"), "s.bin", c, allowOlder); });
+  };
+  EXPECT_EQ(belongs(good, config, false), "");
+  // Another program version: refused; an older one is accepted on request, a newer one never.
+  const std::string older = withVersion(good, "0.0.9"), newer = withVersion(good, "99.0.0");
+  EXPECT_NE(belongs(older, config, false).find("written by grainlab 0.0.9"), std::string::npos);
+  EXPECT_EQ(belongs(older, config, true), "");
+  EXPECT_NE(belongs(newer, config, true).find("written by grainlab 99.0.0"), std::string::npos);
+  // Another engine state layout (a build whose checkpointed structs differ).
+  const std::uint64_t otherLayout = io::stateLayoutTag() ^ 1;
+  EXPECT_NE(belongs(withField(good, 16, &otherLayout, 8), config, true).find("state layout"), std::string::npos);
+  // Another config; the results folder's name is not part of it (a folder may be moved).
+  lab::RunConfig other = config;
+  other.contact.frictionDeg = 31.0;
+  EXPECT_NE(belongs(good, other, false).find("another config"), std::string::npos);
+  lab::RunConfig moved = config;
+  moved.output.dir = "elsewhere/run";
+  EXPECT_EQ(belongs(good, moved, false), "");
+  // A known format but a record that is not what a run writes.
+  const std::string noRecord = io::encodeCheckpoint(config, nlohmann::json{{"summary", 1}}, "x");
+  EXPECT_NE(refusal([&] { io::decodeCheckpoint(noRecord, "s.bin"); }).find("run record"), std::string::npos);
+}
+
+TEST(CheckpointFile, VersionOrder) {
+  EXPECT_LT(io::compareVersions("0.9.1", "0.10.0"), 0);
+  EXPECT_GT(io::compareVersions("1.0", "0.99.99"), 0);
+  EXPECT_EQ(io::compareVersions("0.1.0", "0.1.0"), 0);
+  EXPECT_EQ(io::compareVersions("0.1", "0.1.0"), 0);
+}
