@@ -24,13 +24,18 @@ DENSITY = 2600.0        # [kg/m3]
 DAMPING = 0.3           # Cundall non-viscous damping
 
 
-def build(planes, spheres, moments=True, wall_young=None):
-    """Materials, the six walls and the spheres; returns the walls' common thickness."""
-    sphere_mat = O.materials.append(CohFrictMat(
+def sphere_material(moments=True):
+    """The spheres' CohFrictMat with the [W] parameters; returns its id."""
+    return O.materials.append(CohFrictMat(
         young=YOUNG, poisson=KS_KN, density=DENSITY, frictionAngle=math.radians(FRICTION_DEG),
         isCohesive=False, normalCohesion=-1, shearCohesion=-1, momentRotationLaw=moments,
         alphaKr=BETA if moments else 0.0, alphaKtw=BETA if moments else 0.0,
         etaRoll=ETA if moments else 0.0, etaTwist=ETA if moments else 0.0, label='spheres'))
+
+
+def build(planes, spheres, moments=True, wall_young=None):
+    """Materials, the six walls and the spheres; returns the walls' common thickness."""
+    sphere_mat = sphere_material(moments)
     wall_mat = O.materials.append(CohFrictMat(
         young=wall_young if wall_young is not None else 1e6 * YOUNG, poisson=KS_KN, density=0.0,
         frictionAngle=0.0, isCohesive=False, momentRotationLaw=False, alphaKr=0.0, alphaKtw=0.0,

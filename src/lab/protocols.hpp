@@ -45,7 +45,9 @@ struct Record {
   // Periodic cell: logarithmic axial strain -ln(H_zz/H0_zz), and the skew part of the contact
   // stress relative to p (a check: zero without contact moments at equilibrium).
   double eps1Log = 0.0, stressSkew = 0.0;
-  // Simple shear: shear strain gamma = H_xz / H_zz and shear stress tau = sigma_xz [Pa].
+  // Simple shear: shear strain gamma = H_xz / H_zz and the shear stress the sample opposes to it,
+  // tau = -sigma_xz [Pa] (sigma compression positive: a shear with dx/dt = gamma_dot z loads the
+  // contacts along (-1, 0, 1), so sigma_xz < 0).
   double gamma = 0.0, tau = 0.0;
   // True triaxial: b = (sigma2 - sigma3)/(sigma1 - sigma3) of the recorded stresses (NaN while
   // sigma1 = sigma3, written as an empty field).

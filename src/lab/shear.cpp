@@ -18,18 +18,20 @@ namespace grainlab::lab {
 namespace {
 
 // Lateral stress targets (x = sigma2, y = sigma3) of a stress path, given the axial stress sigma1.
+// A granular sample carries no tension, so a target is never below zero (at constant p that
+// happens once sigma1 > 3p, which a sample with strong contact moments can reach: the mean stress
+// then exceeds p, and the records show it).
 Vec3 lateralTargets(const TestConfig& t, double sigma1) {
   const double p = t.confiningPressure;
+  Vec3 target(p, p, 0.0);
   if (t.type == "constant-p") {
-    const double lateral = 0.5 * (3.0 * p - sigma1);
-    return {lateral, lateral, 0.0};
-  }
-  if (t.type == "true-triaxial") {
+    target.head<2>().setConstant(0.5 * (3.0 * p - sigma1));
+  } else if (t.type == "true-triaxial") {
     // p = (s1 + s2 + s3)/3 and b = (s2 - s3)/(s1 - s3) held: s3 = (3p - (1 + b) s1)/(2 - b).
     const double s3 = (3.0 * p - (1.0 + t.b) * sigma1) / (2.0 - t.b);
-    return {s3 + t.b * (sigma1 - s3), s3, 0.0};
+    target = Vec3(s3 + t.b * (sigma1 - s3), s3, 0.0);
   }
-  return {p, p, 0.0};
+  return target.cwiseMax(0.0);
 }
 
 bool simpleShear(const TestConfig& t) { return t.type == "simple-shear"; }
@@ -85,7 +87,7 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
     r.eps1Log = -std::log(len[2] / h0);
     r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);
     r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
-    r.tau = meanStress ? meanShearStress : 0.5 * (sc(0, 2) + sc(2, 0));
+    r.tau = meanStress ? meanShearStress : -0.5 * (sc(0, 2) + sc(2, 0));
     if (simpleShear(t)) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
   }
   const GrainKinematics k = currentKinematics();
@@ -226,7 +228,7 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
   pipeline.addAfter("load cell", [this, &st, strain, last, final] {
     const Mat3 sc = sim_.boundary == Boundary::Periodic ? sim_.cell.stress : Mat3::Zero();
     st.stressSum += boundaryStress(sim_);
-    st.shearStressSum += 0.5 * (sc(0, 2) + sc(2, 0));
+    st.shearStressSum -= 0.5 * (sc(0, 2) + sc(2, 0));
     const auto walls = singleWallStresses(sim_);
     for (int k = 0; k < 6; ++k) st.wallStressSum[k] += walls[k];
     ++st.stressSamples;

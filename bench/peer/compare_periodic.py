@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Drained triaxial test in a periodic cell, side by side in grainlab and YADE on the same packing.
+
+Usage: compare_periodic.py [--particles 1000] [--strain 0.08] [--rate 1.0] [--out DIR] [--doc FILE]
+
+grainlab prepares the sample (preset periodic-triaxial: the [W] grading 2-8 mm, e0 = 0.60 searched,
+100 kPa) and writes its packing; both programs then start from that packing, re-equilibrate it with
+their own servo and shear it at the same axial strain rate with the lateral stresses held at
+100 kPa. grainlab runs with contact.moment_limit = "yade" (bending and twisting each capped at
+eta min(R1, R2) |Fn|, as YADE's CohFrictPhys does), so that the laws are the same and what differs
+is the engines. Writes both time series, an overlay plot and (with --doc) a Markdown section.
+Needs `yade` on PATH. Child processes get argument vectors, never a shell."""
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+GRAINLAB = os.environ.get("GRAINLAB_BIN", os.path.join(ROOT, "build", "grainlab"))
+LAW = ["--set", 'contact.moment_limit="yade"']
+
+
+def run(argv):
+    t = time.time()
+    subprocess.run(argv, check=True)
+    return time.time() - t
+
+
+def read(path, eps="eps1", epsv="eps_v", phi="phi_deg"):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [(float(r[eps]), float(r[epsv]), float(r[phi])) for r in rows]
+
+
+def at(series, e):
+    """Linear interpolation of (eps_v, phi) at axial strain e."""
+    for (e0, v0, p0), (e1, v1, p1) in zip(series, series[1:]):
+        if e0 <= e <= e1 and e1 > e0:
+            f = (e - e0) / (e1 - e0)
+            return v0 + f * (v1 - v0), p0 + f * (p1 - p0)
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--particles", type=int, default=1000)
+    ap.add_argument("--strain", type=float, default=0.08)
+    ap.add_argument("--rate", type=float, default=1.0)
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--out", default=os.path.join(ROOT, "runs", "peer-periodic"))
+    ap.add_argument("--doc", help="write the Markdown comparison here")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    prep = os.path.join(a.out, "prepared")
+    common = ["--set", f"sample.n_particles={a.particles}", "--threads", str(a.threads), "--quiet", *LAW]
+    run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", prep, "--set", 'test.type="isotropic"',
+         "--set", "output.plots=false", *common])
+    packing = os.path.join(prep, "packing.txt")
+    gl = os.path.join(a.out, "grainlab")
+    tg = run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", gl, "--set", f'sample.packing="{packing}"',
+              "--set", f"test.axial_strain_rate={a.rate}", "--set", f"test.final_axial_strain={a.strain}",
+              "--set", "output.plots=false", "--set", "output.vtk_every_strain=0", *common])
+    yade_csv = os.path.join(a.out, "yade.csv")
+    ty = run(["yade", "-n", "-x", os.path.join(HERE, "yade_periodic.py"), packing, yade_csv,
+              "--strain", str(a.strain), "--rate", str(a.rate)])
+    g = read(os.path.join(gl, "timeseries.csv"))
+    y = read(yade_csv)
+    summary = json.load(open(os.path.join(gl, "summary.json")))
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    for s, label in ((g, "grainlab"), (y, "YADE 2023.02a")):
+        ax[0].plot([100 * r[0] for r in s], [r[2] for r in s], label=label)
+        ax[1].plot([100 * r[0] for r in s], [100 * r[1] for r in s], label=label)
+    ax[0].set_xlabel("eps1 [%]"); ax[0].set_ylabel("mobilised friction angle phi [deg]")
+    ax[1].set_xlabel("eps1 [%]"); ax[1].set_ylabel("eps_v [%] (contraction +)")
+    for x in ax:
+        x.grid(alpha=0.3)
+        x.legend()
+    fig.suptitle(f"periodic cell, {a.particles} spheres, e0 = {summary['e0']:.3f}, p = 100 kPa, same packing and law")
+    fig.tight_layout()
+    png = os.path.join(a.out, "compare_periodic.png")
+    fig.savefig(png, dpi=110)
+
+    lines = ["| eps1 | phi grainlab | phi YADE | eps_v grainlab | eps_v YADE |", "|---:|---:|---:|---:|---:|"]
+    for e in (0.001, 0.0025, 0.005, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08):
+        if e > a.strain:
+            break
+        pg, py = at(g, e), at(y, e)
+        if pg and py:
+            lines.append(f"| {100 * e:.2g} % | {pg[1]:.1f} | {py[1]:.1f} | {100 * pg[0]:+.2f} % | {100 * py[0]:+.2f} % |")
+    peak = lambda s: max(s, key=lambda r: r[2])
+    pg, py = peak(g), peak(y)
+    lines.append("")
+    lines.append(f"Peak: grainlab {pg[2]:.1f} deg at {100 * pg[0]:.2f} %, YADE {py[2]:.1f} deg at {100 * py[0]:.2f} %. "
+                 f"Shear wall time: grainlab {tg:.0f} s ({a.threads} thread), YADE {ty:.0f} s.")
+    table = "\n".join(lines)
+    print(table)
+    if a.doc:
+        with open(a.doc, "w") as f:
+            f.write(table + "\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
