@@ -15,10 +15,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+def number(text):
+    """A CSV cell as a float; an empty cell is a value that could not be measured (NaN, not 0)."""
+    return float(text) if text not in ("", None) else float("nan")
+
+
 def read_columns(path):
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
+    return {k: [number(r[k]) for r in rows] for k in rows[0]} if rows else {}
 
 
 def save(fig, path):

@@ -31,7 +31,7 @@ def main(directory):
             with open(path, newline="") as f:
                 data = list(csv.DictReader(f))
             legend = ", ".join(f"{k.split('.')[-1]}={r[k]}" for k in varied)
-            ax.plot([100 * float(d["eps1"]) for d in data], [scale * float(d[column]) for d in data],
+            ax.plot([100 * float(d["eps1"]) for d in data], [scale * (float(d[column]) if d[column] else float("nan")) for d in data],
                     lw=1.2, label=legend)
         ax.set_xlabel("axial strain eps1 [%]")
         ax.set_ylabel(label)

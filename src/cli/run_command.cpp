@@ -96,6 +96,13 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   Simulation packed;
   io::simulationFromPacking(packing, config.sample.density, packed,
                             fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
+  // The boundary is part of the test: a packing made in a cell cannot be sheared between walls, nor the reverse.
+  const bool periodic = packed.boundary == Boundary::Periodic;
+  if (periodic != (config.test.boundary == "periodic"))
+    throw InputError(fmt::format("config error: sample.packing = {}: the packing's boundary is {} but "
+                                 "test.boundary = \"{}\"; allowed: the packing's own boundary",
+                                 io::quotedPath(config.sample.packing), periodic ? "a periodic cell" : "walls",
+                                 config.test.boundary));
   return packed;
 }
 

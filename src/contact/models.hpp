@@ -29,6 +29,14 @@ struct ContactHistory {
   bool touching = false;
 };
 
+// History of a contact with an ellipsoid: the law's, plus the Perram–Wertheim parameter lambda of
+// the last step (the warm start of the next solve) and the length of the contact's potential,
+// frozen when the contact forms (geometry/ellipsoid_contacts.hpp, docs/ellipsoids.md).
+struct EllipsoidHistory : ContactHistory {
+  double lambda = 0.0;
+  double potentialLength = 0.0;
+};
+
 // What the law returns: force of A on B, and the contact moment accumulated from the rotation of
 // B relative to A (B receives -moment, A receives +moment; PHYSICS.md §3.1).
 struct ContactResponse {
@@ -90,10 +98,17 @@ struct SphereContactModel {
   // 2023's eta min(RA,RB) |Fn| on bending and on twisting separately (true), so that a comparison
   // with YADE shows the engines' differences, not the laws'.
   bool yadeMomentLimit = false;
+  // When > 0, every contact's normal stiffness Kn [N/m] (walls too), with Ks = poisson Kn: the
+  // constant stiffness of [O] instead of Kn from the radii and Ec.
+  double constantKn = 0.0;
+
+  double normalStiffness(double rA, double rB) const {
+    return constantKn > 0.0 ? constantKn : 2.0 * young * rA * rB / (rA + rB);
+  }
 
   // muA, muB: the grains' rolling friction (Linear law only).
   PairParams pairParams(double rA, double rB, double muA = 0.0, double muB = 0.0) const {
-    const double kn = 2.0 * young * rA * rB / (rA + rB);
+    const double kn = normalStiffness(rA, rB);
     const double ks = poisson * kn;
     if (rolling == RollingLaw::Linear) {
       const double rBar = rA * rB / (rA + rB);
@@ -107,16 +122,16 @@ struct SphereContactModel {
   // rolling stiffness is the R_B -> infinity limit (beta Ks r^2, or Ks r^2 with R = r) and the limit
   // arm eta r (the (RA+RB)/2 arm has no finite limit for a plane) or mu_r r.
   PairParams wallParams(double r, double wallTanFriction, double mu = 0.0) const {
-    const double kn = 2.0 * young * r;
+    const double kn = maxNormalStiffness(r);
     const double ks = poisson * kn;
     if (wallTanFriction <= 0.0) return {kn, ks, 0.0, 0.0, 0.0, true};
     if (rolling == RollingLaw::Linear) return {kn, ks, ks * r * r, wallTanFriction, mu * r, false};
     return {kn, ks, beta * ks * r * r, wallTanFriction, eta * r, true};
   }
   // Stiffest contact a sphere of radius r can have (against a wall), for the critical time step.
-  double maxNormalStiffness(double r) const { return 2.0 * young * r; }
+  double maxNormalStiffness(double r) const { return constantKn > 0.0 ? constantKn : 2.0 * young * r; }
   double maxRotationalStiffness(double r) const {
-    const double ks = poisson * 2.0 * young * r;
+    const double ks = constantKn > 0.0 ? poisson * constantKn : poisson * 2.0 * young * r;
     const double kr = rolling == RollingLaw::Linear ? ks * r * r : beta * ks * r * r;
     return ks * r * r + kr;  // shear spring at arm r plus the rolling spring
   }

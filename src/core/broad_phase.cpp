@@ -76,6 +76,33 @@ std::vector<PairKey> BroadPhase::scanPairs(std::size_t n, Partners&& partners) {
   return keys;
 }
 
+void BroadPhase::assignPairs(const Particles& particles, const std::vector<PairKey>& keys, ContactStore& contacts) {
+  // Candidate pairs by the shapes of their bodies. A sphere–ellipsoid pair is keyed sphere first,
+  // with the image shift of the ellipsoid (negated when the two trade places), and re-sorted.
+  const std::size_t n = particles.size();
+  if (!particles.anyEllipsoid()) {
+    contacts.sphereSphere.assign(keys, n);
+    contacts.ellipsoidEllipsoid.assign({}, n);
+    contacts.sphereEllipsoid.assign({}, n);
+    return;
+  }
+  std::vector<PairKey> ss, ee, se;
+  for (const PairKey& k : keys) {
+    const bool sa = particles.shape[k.a] == Shape::Sphere, sb = particles.shape[k.b] == Shape::Sphere;
+    if (sa && sb) ss.push_back(k);
+    else if (!sa && !sb) ee.push_back(k);
+    else if (sa) se.push_back(k);
+    else {
+      const auto s = ImageShift::unpack(k.shift);
+      se.push_back({k.b, k.a, ImageShift::pack(-s[0], -s[1], -s[2])});
+    }
+  }
+  std::sort(se.begin(), se.end());
+  contacts.sphereSphere.assign(ss, n);
+  contacts.ellipsoidEllipsoid.assign(ee, n);
+  contacts.sphereEllipsoid.assign(se, n);
+}
+
 void BroadPhase::buildWalls(const Particles& particles, const WallBox& box, ContactStore& contacts) {
   const std::size_t n = particles.size();
   const auto& x = particles.position;
@@ -107,15 +134,17 @@ void BroadPhase::buildWalls(const Particles& particles, const WallBox& box, Cont
       if ((x[b] - x[a]).squaredNorm() < reach * reach) found.push_back({a, b, ImageShift::kZero});
     });
   });
-  contacts.sphereSphere.assign(keys, n);
+  assignPairs(particles, keys, contacts);
 
-  // Wall candidates, sorted by particle then wall.
-  std::vector<PairKey> wallKeys;
+  // Wall candidates, sorted by particle then wall, by shape.
+  std::vector<PairKey> wallKeys, ellipsoidWallKeys;
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 6; ++k)
       if (box.walls[k].distance(x[i]) < r[i] + skin)
-        wallKeys.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), ImageShift::kZero});
+        (particles.shape[i] == Shape::Sphere ? wallKeys : ellipsoidWallKeys)
+            .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), ImageShift::kZero});
   contacts.sphereWall.assign(wallKeys, n);
+  contacts.ellipsoidWall.assign(ellipsoidWallKeys, n);
 
   positionAtBuild_ = x;
   for (int k = 0; k < 6; ++k) wallPositionAtBuild_[k] = box.walls[k].position;
@@ -152,8 +181,9 @@ void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& c
       if ((image - x[a]).squaredNorm() < reachAB * reachAB) found.push_back({a, b, ImageShift::pack(s[0], s[1], s[2])});
     });
   });
-  contacts.sphereSphere.assign(keys, n);
+  assignPairs(particles, keys, contacts);
   contacts.sphereWall.assign({}, n);
+  contacts.ellipsoidWall.assign({}, n);
 
   positionAtBuild_ = x;
   cellAtBuildInverse_ = cell.hInverse;

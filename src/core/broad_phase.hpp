@@ -49,6 +49,8 @@ class BroadPhase {
   std::array<double, 6> wallPositionAtBuild_{};
   Mat3 cellAtBuildInverse_ = Mat3::Identity();
   SpatialGrid grid_;
+  // Distributes candidate pairs (sorted, a < b) to the pair kinds by shape.
+  static void assignPairs(const Particles& particles, const std::vector<PairKey>& keys, ContactStore& contacts);
   // Sorted keys of every particle pair within reach, from a parallel scan of `partners`.
   template <class Partners>
   std::vector<PairKey> scanPairs(std::size_t n, Partners&& partners);

@@ -15,6 +15,7 @@
 #include "core/particles.hpp"
 #include "core/periodic_cell.hpp"
 #include "core/walls.hpp"
+#include "geometry/ellipsoid_contacts.hpp"
 #include "geometry/sphere_contacts.hpp"
 
 namespace grainlab {
@@ -26,6 +27,8 @@ struct ContactContext {
   const WallBox& box;
   const PeriodicCell& cell;
   double dt;
+  // Shape matrices X = Q diag(a^2, b^2, c^2) Q^T of the step, per particle (ellipsoids only).
+  const std::vector<geometry::Sym3>* shapeMatrices = nullptr;
 };
 
 // Terms summed per chunk of contacts (deterministic, see parallel.hpp).
@@ -42,6 +45,72 @@ enum ContactSum : int {
 
 namespace detail {
 
+// Kinematics of a particle pair at the contact point (every particle–particle kind).
+template <bool Periodic>
+GRAINLAB_ALWAYS_INLINE contact::ContactKinematics pairKinematics(const ContactContext& ctx, std::uint32_t a,
+                                                                 std::uint32_t b, const geometry::ContactGeometry& g,
+                                                                 const Vec3& branch) {
+  const auto& v = ctx.particles.velocity;
+  const auto& w = ctx.particles.angularVelocity;
+  contact::ContactKinematics k;
+  k.normal = g.normal;
+  k.overlap = g.overlap;
+  k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
+  // In a periodic cell the bodies' velocities are fluctuations about the homogeneous flow, whose
+  // relative velocity across the branch (image shift included) is L l (PHYSICS.md §2, §5.2).
+  if constexpr (Periodic) k.relativeVelocity += ctx.cell.velocityGradient * branch;
+  k.relativeSpin = w[b] - w[a];
+  k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
+  k.dt = ctx.dt;
+  return k;
+}
+
+// Kinematics of a particle (body B) against a wall (body A).
+GRAINLAB_ALWAYS_INLINE contact::ContactKinematics wallKinematics(const ContactContext& ctx, std::uint32_t i,
+                                                                 const Wall& wall, const geometry::ContactGeometry& g) {
+  const auto& v = ctx.particles.velocity;
+  const auto& w = ctx.particles.angularVelocity;
+  Vec3 wallVelocity = Vec3::Zero();
+  wallVelocity[wall.axis] = wall.velocity;
+  contact::ContactKinematics k;
+  k.normal = g.normal;
+  k.overlap = g.overlap;
+  k.relativeVelocity = v[i] + w[i].cross(g.branchB) - wallVelocity;
+  k.relativeSpin = w[i];
+  k.meanSpinNormal = 0.5 * w[i].dot(g.normal);
+  k.dt = ctx.dt;
+  return k;
+}
+
+template <class List>
+GRAINLAB_ALWAYS_INLINE void storePair(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                      const contact::ContactResponse& res) {
+  list.force[c] = res.force;
+  list.torqueA[c] = g.branchA.cross(-res.force) + res.moment;
+  list.torqueB[c] = g.branchB.cross(res.force) - res.moment;
+}
+
+template <class List>
+GRAINLAB_ALWAYS_INLINE void storeWall(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                      const contact::ContactResponse& res) {
+  list.force[c] = res.force;
+  list.torqueA[c] = g.branchB.cross(res.force) - res.moment;
+}
+
+template <bool Periodic, class List>
+GRAINLAB_ALWAYS_INLINE Vec3 pairBranch(const ContactContext& ctx, const List& list, std::size_t c) {
+  const auto& x = ctx.particles.position;
+  if constexpr (Periodic) return x[list.b[c]] + ctx.cell.shiftVector(list.shift[c]) - x[list.a[c]];
+  else return x[list.b[c]] - x[list.a[c]];
+}
+
+// The plane of a wall through the particle's projection on it.
+GRAINLAB_ALWAYS_INLINE Vec3 wallPoint(const Wall& wall, const Vec3& x) {
+  Vec3 p = x;
+  p[wall.axis] = wall.position;
+  return p;
+}
+
 // The narrow phase and kinematics of one contact of a kind: fills geometry and kinematics and
 // returns false when the bodies are apart.
 template <class Kind, bool Periodic>
@@ -49,98 +118,164 @@ struct KindKernel;
 
 template <bool Periodic>
 struct KindKernel<SphereSphere, Periodic> {
-  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const ContactList<SphereSphere>& list,
-                                              std::size_t c, geometry::ContactGeometry& g, Vec3& branch) {
-    const auto& x = ctx.particles.position;
+  using List = ContactList<SphereSphere>;
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
+                                              contact::ContactHistory&, geometry::ContactGeometry& g, Vec3& branch) {
     const auto& rad = ctx.particles.radius;
     const std::uint32_t a = list.a[c], b = list.b[c];
-    if constexpr (Periodic) branch = x[b] + ctx.cell.shiftVector(list.shift[c]) - x[a];
-    else branch = x[b] - x[a];
+    branch = pairBranch<Periodic>(ctx, list, c);
     const double dist2 = branch.squaredNorm();
     const double reach = rad[a] + rad[b];
     if (dist2 >= reach * reach) return false;
     g = geometry::sphereSphere(branch, dist2, rad[a], rad[b]);
     return true;
   }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx,
-                                                                      const ContactList<SphereSphere>& list,
-                                                                      std::size_t c,
-                                                                      const geometry::ContactGeometry& g,
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
                                                                       const Vec3& branch) {
-    const auto& v = ctx.particles.velocity;
-    const auto& w = ctx.particles.angularVelocity;
-    const std::uint32_t a = list.a[c], b = list.b[c];
-    contact::ContactKinematics k;
-    k.normal = g.normal;
-    k.overlap = g.overlap;
-    k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
-    // In a periodic cell the bodies' velocities are fluctuations about the homogeneous flow, whose
-    // relative velocity across the branch (image shift included) is L l (PHYSICS.md §2, §5.2).
-    if constexpr (Periodic) k.relativeVelocity += ctx.cell.velocityGradient * branch;
-    k.relativeSpin = w[b] - w[a];
-    k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);
-    k.dt = ctx.dt;
-    return k;
+    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
   }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx,
-                                                           const ContactList<SphereSphere>& list, std::size_t c) {
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
     const auto& rad = ctx.particles.radius;
     const auto& mu = ctx.particles.rollingFriction;
     const std::uint32_t a = list.a[c], b = list.b[c];
     return ctx.model.pairParams(rad[a], rad[b], mu[a], mu[b]);
   }
-  GRAINLAB_ALWAYS_INLINE static void store(ContactList<SphereSphere>& list, std::size_t c,
-                                           const geometry::ContactGeometry& g, const contact::ContactResponse& res) {
-    list.force[c] = res.force;
-    list.torqueA[c] = g.branchA.cross(-res.force) + res.moment;
-    list.torqueB[c] = g.branchB.cross(res.force) - res.moment;
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storePair(list, c, g, res);
   }
 };
 
 template <bool Periodic>
 struct KindKernel<SpherePlane, Periodic> {
+  using List = ContactList<SpherePlane>;
   // The wall is body A, the sphere body B (the plane's normal points into the sphere's side).
-  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const ContactList<SpherePlane>& list,
-                                              std::size_t c, geometry::ContactGeometry& g, Vec3&) {
-    const auto& x = ctx.particles.position;
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
+                                              contact::ContactHistory&, geometry::ContactGeometry& g, Vec3&) {
     const std::uint32_t i = list.a[c];
     const Wall& wall = ctx.box.walls[list.b[c]];
-    const Vec3 n = wall.inwardNormal();
-    Vec3 planePoint = x[i];
-    planePoint[wall.axis] = wall.position;
-    g = geometry::spherePlane(x[i], ctx.particles.radius[i], planePoint, n);
+    const Vec3& x = ctx.particles.position[i];
+    g = geometry::spherePlane(x, ctx.particles.radius[i], wallPoint(wall, x), wall.inwardNormal());
     return g.overlap > 0.0;
   }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx,
-                                                                      const ContactList<SpherePlane>& list,
-                                                                      std::size_t c,
-                                                                      const geometry::ContactGeometry& g,
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
                                                                       const Vec3&) {
-    const auto& v = ctx.particles.velocity;
-    const auto& w = ctx.particles.angularVelocity;
-    const std::uint32_t i = list.a[c];
-    const Wall& wall = ctx.box.walls[list.b[c]];
-    Vec3 wallVelocity = Vec3::Zero();
-    wallVelocity[wall.axis] = wall.velocity;
-    contact::ContactKinematics k;
-    k.normal = g.normal;
-    k.overlap = g.overlap;
-    k.relativeVelocity = v[i] + w[i].cross(g.branchB) - wallVelocity;
-    k.relativeSpin = w[i];
-    k.meanSpinNormal = 0.5 * w[i].dot(g.normal);
-    k.dt = ctx.dt;
-    return k;
+    return wallKinematics(ctx, list.a[c], ctx.box.walls[list.b[c]], g);
   }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx,
-                                                           const ContactList<SpherePlane>& list, std::size_t c) {
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
     const std::uint32_t i = list.a[c];
     return ctx.model.wallParams(ctx.particles.radius[i], ctx.box.walls[list.b[c]].tanFriction,
                                 ctx.particles.rollingFriction[i]);
   }
-  GRAINLAB_ALWAYS_INLINE static void store(ContactList<SpherePlane>& list, std::size_t c,
-                                           const geometry::ContactGeometry& g, const contact::ContactResponse& res) {
-    list.force[c] = res.force;
-    list.torqueA[c] = g.branchB.cross(res.force) - res.moment;
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storeWall(list, c, g, res);
+  }
+};
+
+// Ellipsoid pairs: bounding spheres, then the line-of-centres filter, then the Perram–Wertheim
+// solve warm-started from the lambda of the last step, with the potential length frozen when the
+// contact forms (docs/ellipsoids.md).
+template <bool Periodic>
+struct KindKernel<EllipsoidEllipsoid, Periodic> {
+  using List = ContactList<EllipsoidEllipsoid>;
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
+                                              contact::EllipsoidHistory& h, geometry::ContactGeometry& g,
+                                              Vec3& branch) {
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    const auto& rad = ctx.particles.radius;
+    branch = pairBranch<Periodic>(ctx, list, c);
+    if (!geometry::boundingSpheresOverlap(branch, rad[a], rad[b])) return false;
+    const auto& xs = *ctx.shapeMatrices;
+    if (geometry::separatedAlongCentreLine(branch, xs[a], xs[b])) return false;
+    const geometry::EllipsoidContact e =
+        geometry::ellipsoidEllipsoid(branch, xs[a], xs[b], h.lambda, h.touching ? h.potentialLength : 0.0);
+    if (!e.touching) return false;
+    h.lambda = e.lambda;
+    h.potentialLength = e.potentialLength;
+    g = e.geometry;
+    return true;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
+                                                                      const Vec3& branch) {
+    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
+    const auto& r = ctx.particles.equivalentRadius;
+    const auto& mu = ctx.particles.rollingFriction;
+    return ctx.model.pairParams(r[list.a[c]], r[list.b[c]], mu[list.a[c]], mu[list.b[c]]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storePair(list, c, g, res);
+  }
+};
+
+// A sphere (body a) and an ellipsoid (body b), solved in the ellipsoid's frame.
+template <bool Periodic>
+struct KindKernel<SphereEllipsoid, Periodic> {
+  using List = ContactList<SphereEllipsoid>;
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
+                                              contact::EllipsoidHistory& h, geometry::ContactGeometry& g,
+                                              Vec3& branch) {
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    const Particles& P = ctx.particles;
+    branch = pairBranch<Periodic>(ctx, list, c);
+    if (!geometry::boundingSpheresOverlap(branch, P.radius[a], P.radius[b])) return false;
+    const geometry::EllipsoidContact e = geometry::sphereEllipsoid(branch, P.radius[a], P.semiAxes[b], P.orientation[b],
+                                                                   h.lambda, h.touching ? h.potentialLength : 0.0);
+    if (!e.touching) return false;
+    h.lambda = e.lambda;
+    h.potentialLength = e.potentialLength;
+    g = e.geometry;
+    return true;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
+                                                                      const Vec3& branch) {
+    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
+    const auto& r = ctx.particles.equivalentRadius;
+    const auto& mu = ctx.particles.rollingFriction;
+    return ctx.model.pairParams(r[list.a[c]], r[list.b[c]], mu[list.a[c]], mu[list.b[c]]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storePair(list, c, g, res);
+  }
+};
+
+// An ellipsoid (body B) against a wall (body A): the closed-form support point.
+template <bool Periodic>
+struct KindKernel<EllipsoidPlane, Periodic> {
+  using List = ContactList<EllipsoidPlane>;
+  GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
+                                              contact::ContactHistory&, geometry::ContactGeometry& g, Vec3&) {
+    const std::uint32_t i = list.a[c];
+    const Wall& wall = ctx.box.walls[list.b[c]];
+    const Vec3& x = ctx.particles.position[i];
+    const geometry::EllipsoidPlaneContact e =
+        geometry::ellipsoidPlane(x, (*ctx.shapeMatrices)[i], wallPoint(wall, x), wall.inwardNormal());
+    g = e.geometry;
+    return e.touching;
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
+                                                                      const Vec3&) {
+    return wallKinematics(ctx, list.a[c], ctx.box.walls[list.b[c]], g);
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
+    const std::uint32_t i = list.a[c];
+    return ctx.model.wallParams(ctx.particles.equivalentRadius[i], ctx.box.walls[list.b[c]].tanFriction,
+                                ctx.particles.rollingFriction[i]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storeWall(list, c, g, res);
   }
 };
 
@@ -162,7 +297,7 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
       typename Kind::History& h = list.history[c];
       geometry::ContactGeometry g;
       Vec3 branch;
-      if (!Kernel::evaluate(ctx, list, c, g, branch)) {
+      if (!Kernel::evaluate(ctx, list, c, h, g, branch)) {
         // A pair that was apart and still is keeps its zero slots, so it is skipped without a write.
         if (!h.touching && !writeAll) continue;
         if (h.touching) {
@@ -173,7 +308,7 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
           if (p.ks > 0.0) slip += 0.5 * h.shearForce.squaredNorm() / p.ks;
           if (p.kr > 0.0) roll += 0.5 * h.moment.squaredNorm() / p.kr;
         }
-        h = typename Kind::History{};
+        h = typename Kind::History{};  // (an ellipsoid pair's lambda restarts cold: its solve is cheap)
         list.force[c].setZero();
         list.torqueA[c].setZero();
         if constexpr (!Kind::kPlane) list.torqueB[c].setZero();

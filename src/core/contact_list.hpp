@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <compare>
+#include <type_traits>
 #include <cstdint>
 #include <iosfwd>
 #include <vector>
@@ -24,16 +25,38 @@ struct PairKey {
   auto operator<=>(const PairKey&) const = default;
 };
 
-// The pair kinds. Each names its history type and whether its second body is a wall (plane).
+// The pair kinds. Each names its history type, whether its second body is a wall (plane), and
+// whether its pairs are keyed with a < b (the pair kinds of one shape) or by role (sphere first,
+// ellipsoid second, whatever their indices).
 struct SphereSphere {
   using History = contact::ContactHistory;
   static constexpr bool kPlane = false;
+  static constexpr bool kIndexOrdered = true;
   static constexpr const char* kName = "sphere-sphere";
 };
 struct SpherePlane {
   using History = contact::ContactHistory;
   static constexpr bool kPlane = true;
+  static constexpr bool kIndexOrdered = false;
   static constexpr const char* kName = "sphere-wall";
+};
+struct EllipsoidEllipsoid {
+  using History = contact::EllipsoidHistory;
+  static constexpr bool kPlane = false;
+  static constexpr bool kIndexOrdered = true;
+  static constexpr const char* kName = "ellipsoid-ellipsoid";
+};
+struct SphereEllipsoid {
+  using History = contact::EllipsoidHistory;
+  static constexpr bool kPlane = false;
+  static constexpr bool kIndexOrdered = false;
+  static constexpr const char* kName = "sphere-ellipsoid";
+};
+struct EllipsoidPlane {
+  using History = contact::ContactHistory;
+  static constexpr bool kPlane = true;
+  static constexpr bool kIndexOrdered = false;
+  static constexpr const char* kName = "ellipsoid-wall";
 };
 
 template <class Kind>
@@ -105,12 +128,13 @@ class ContactList {
   }
 
   // Renumbers particles: particle old index k is now at newIndex[k]; re-sorts keys with history.
+  // Pairs of an index-ordered kind are swapped where needed to keep a < b.
   void renumber(const std::vector<std::uint32_t>& newIndex, std::size_t nParticles) {
     std::vector<PairKey> keys(size());
     for (std::size_t c = 0; c < size(); ++c) {
       std::uint32_t x = newIndex[a[c]], y = Kind::kPlane ? b[c] : newIndex[b[c]];
       std::uint32_t s = shift[c];
-      if (!Kind::kPlane && y < x) {  // pairs are kept with a < b: swap the bodies, negate the shift
+      if (Kind::kIndexOrdered && y < x) {  // pairs are kept with a < b: swap the bodies, negate the shift
         std::swap(x, y);
         const auto v = ImageShift::unpack(s);
         s = ImageShift::pack(-v[0], -v[1], -v[2]);
@@ -127,10 +151,11 @@ class ContactList {
       h[c] = history[order[c]];
       // A swapped pair's history was written from A's side: its shear force and moment are those of
       // A on B, so they change sign with the roles, and the normal flips.
-      if (!Kind::kPlane && newIndex[this->a[order[c]]] != sorted[c].a) {
+      if (Kind::kIndexOrdered && newIndex[this->a[order[c]]] != sorted[c].a) {
         h[c].shearForce = -h[c].shearForce;
         h[c].moment = -h[c].moment;
         h[c].prevNormal = -h[c].prevNormal;
+        if constexpr (std::is_same_v<History, contact::EllipsoidHistory>) h[c].lambda = 1.0 - h[c].lambda;
       }
     }
     a.clear();
@@ -184,16 +209,38 @@ class ContactList {
 struct ContactStore {
   ContactList<SphereSphere> sphereSphere;
   ContactList<SpherePlane> sphereWall;
+  ContactList<EllipsoidEllipsoid> ellipsoidEllipsoid;
+  ContactList<SphereEllipsoid> sphereEllipsoid;
+  ContactList<EllipsoidPlane> ellipsoidWall;
 
   template <class F>
   void forEach(F&& f) {
     f(sphereSphere);
     f(sphereWall);
+    f(ellipsoidEllipsoid);
+    f(sphereEllipsoid);
+    f(ellipsoidWall);
   }
   template <class F>
   void forEach(F&& f) const {
     f(sphereSphere);
     f(sphereWall);
+    f(ellipsoidEllipsoid);
+    f(sphereEllipsoid);
+    f(ellipsoidWall);
+  }
+  // The particle–particle kinds only.
+  template <class F>
+  void forEachPair(F&& f) {
+    f(sphereSphere);
+    f(ellipsoidEllipsoid);
+    f(sphereEllipsoid);
+  }
+  template <class F>
+  void forEachPair(F&& f) const {
+    f(sphereSphere);
+    f(ellipsoidEllipsoid);
+    f(sphereEllipsoid);
   }
 };
 

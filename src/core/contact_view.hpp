@@ -3,6 +3,7 @@
 // micromechanical analysis (not for the hot loop): one visitor instead of a loop per kind and
 // boundary in every client.
 #include "core/simulation.hpp"
+#include "geometry/ellipsoid_contacts.hpp"
 
 namespace grainlab {
 
@@ -14,10 +15,14 @@ struct ContactView {
   Vec3 force = Vec3::Zero();
   Vec3 normal = Vec3::Zero();  // pairs: from a to b; walls: the wall's inward normal (into a)
   // Pairs: x_b (its periodic image, when the contact crosses a face) - x_a. Walls: contact point - x_a.
+  // (For an ellipsoid pair armA - armB = branch, but the arms are not along the normal.)
   Vec3 branch = Vec3::Zero();
   // Contact point minus the centre of a and of b (for a wall only armA is meaningful).
   Vec3 armA = Vec3::Zero(), armB = Vec3::Zero();
-  double overlap = 0.0;  // [m]
+  double overlap = 0.0;  // [m] force-equivalent: Fn = kn overlap
+  // Energy stored in the normal spring [J]: kn overlap^2 / 2, or for an ellipsoid pair the
+  // potential of its contact function (docs/ellipsoids.md).
+  double normalEnergy = 0.0;
   contact::PairParams params{};
   const contact::ContactHistory* history = nullptr;
 };
@@ -45,6 +50,7 @@ void forEachTouchingContact(const Simulation& sim, F&& f) {
     v.armA = (r[v.a] - 0.5 * v.overlap) * v.normal;
     v.armB = v.armA - v.branch;
     v.params = sim.model.pairParams(r[v.a], r[v.b], mu[v.a], mu[v.b]);
+    v.normalEnergy = 0.5 * v.params.kn * v.overlap * v.overlap;
     v.history = &pairs.history[c];
     f(static_cast<const ContactView&>(v));
   }
@@ -63,7 +69,71 @@ void forEachTouchingContact(const Simulation& sim, F&& f) {
     v.branch = -(r[v.a] - 0.5 * v.overlap) * v.normal;
     v.armA = v.branch;
     v.params = sim.model.wallParams(r[v.a], wall.tanFriction, mu[v.a]);
+    v.normalEnergy = 0.5 * v.params.kn * v.overlap * v.overlap;
     v.history = &walls.history[c];
+    f(static_cast<const ContactView&>(v));
+  }
+  if (!P.anyEllipsoid()) return;
+  // Ellipsoid kinds: the geometry again from the kernels, warm-started from the contact's lambda
+  // and with its frozen potential length, so it is the geometry the law saw.
+  const auto& req = P.equivalentRadius;
+  auto shapeOf = [&](std::uint32_t i) { return geometry::shapeMatrix(P.semiAxes[i], P.orientation[i]); };
+  auto pairView = [&](const auto& list, std::size_t c, const geometry::EllipsoidContact& e) {
+    ContactView v;
+    v.a = list.a[c];
+    v.b = list.b[c];
+    v.force = list.force[c];
+    v.branch = x[v.b] - x[v.a];
+    if (sim.boundary == Boundary::Periodic) v.branch += sim.cell.shiftVector(list.shift[c]);
+    v.normal = e.geometry.normal;
+    v.overlap = e.geometry.overlap;
+    v.armA = e.geometry.branchA;
+    v.armB = e.geometry.branchB;
+    v.params = sim.model.pairParams(req[v.a], req[v.b], mu[v.a], mu[v.b]);
+    v.normalEnergy = v.params.kn * e.energyOverKn;
+    v.history = &list.history[c];
+    return v;
+  };
+  const auto& ee = sim.contacts.ellipsoidEllipsoid;
+  for (std::size_t c = 0; c < ee.size(); ++c) {
+    const auto& h = ee.history[c];
+    if (!h.touching) continue;
+    Vec3 branch = x[ee.b[c]] - x[ee.a[c]];
+    if (sim.boundary == Boundary::Periodic) branch += sim.cell.shiftVector(ee.shift[c]);
+    const geometry::EllipsoidContact e =
+        geometry::ellipsoidEllipsoid(branch, shapeOf(ee.a[c]), shapeOf(ee.b[c]), h.lambda, h.potentialLength);
+    if (e.touching) f(static_cast<const ContactView&>(pairView(ee, c, e)));
+  }
+  const auto& se = sim.contacts.sphereEllipsoid;
+  for (std::size_t c = 0; c < se.size(); ++c) {
+    const auto& h = se.history[c];
+    if (!h.touching) continue;
+    Vec3 branch = x[se.b[c]] - x[se.a[c]];
+    if (sim.boundary == Boundary::Periodic) branch += sim.cell.shiftVector(se.shift[c]);
+    const geometry::EllipsoidContact e =
+        geometry::sphereEllipsoid(branch, r[se.a[c]], P.semiAxes[se.b[c]], P.orientation[se.b[c]], h.lambda,
+                                  h.potentialLength);
+    if (e.touching) f(static_cast<const ContactView&>(pairView(se, c, e)));
+  }
+  const auto& ew = sim.contacts.ellipsoidWall;
+  for (std::size_t c = 0; c < ew.size(); ++c) {
+    if (!ew.history[c].touching) continue;
+    ContactView v;
+    v.a = ew.a[c];
+    v.b = ew.b[c];
+    v.wall = true;
+    const Wall& wall = sim.box.walls[v.b];
+    Vec3 point = x[v.a];
+    point[wall.axis] = wall.position;
+    const geometry::EllipsoidPlaneContact e = geometry::ellipsoidPlane(x[v.a], shapeOf(v.a), point, wall.inwardNormal());
+    v.force = ew.force[c];
+    v.normal = wall.inwardNormal();
+    v.overlap = e.geometry.overlap;
+    v.branch = e.geometry.branchB;
+    v.armA = v.branch;
+    v.params = sim.model.wallParams(req[v.a], wall.tanFriction, mu[v.a]);
+    v.normalEnergy = v.params.kn * e.energyOverKn;
+    v.history = &ew.history[c];
     f(static_cast<const ContactView&>(v));
   }
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/state_io.hpp"
+#include "geometry/ellipsoid_shape.hpp"
 
 namespace grainlab {
 
@@ -25,13 +26,58 @@ void Particles::addSphere(const Vec3& x, double r, double density, std::uint64_t
   invInertia.push_back(1.0 / inertia.back());
   rollingFriction.push_back(0.0);
   image.push_back({0, 0, 0});
+  principalInertia.push_back(Vec3::Constant(inertia.back()));
+  angularMomentum.push_back(Vec3::Zero());
+  equivalentRadius.push_back(r);
+}
+
+void Particles::addEllipsoid(const Vec3& x, const Vec3& semiAxes, const Quat& q, double density, std::uint64_t newId) {
+  addSphere(x, semiAxes.maxCoeff(), density, newId);
+  orientation.back() = q.normalized();
+  setShape(size() - 1, semiAxes, density);
+}
+
+void Particles::setShape(std::size_t i, const Vec3& s, double density) {
+  if (s[0] == s[1] && s[1] == s[2]) {
+    const Vec3 w = angularVelocity[i];
+    shape[i] = Shape::Sphere;
+    setSphereRadius(i, s[0], density);
+    principalInertia[i] = Vec3::Constant(inertia[i]);
+    angularMomentum[i].setZero();
+    angularVelocity[i] = w;
+    return;
+  }
+  shape[i] = Shape::Ellipsoid;
+  semiAxes[i] = s;
+  radius[i] = geometry::boundingRadius(s);
+  equivalentRadius[i] = geometry::equivalentRadius(s);
+  const double m = geometry::ellipsoidMass(s, density);
+  principalInertia[i] = geometry::ellipsoidPrincipalInertia(s, m);
+  setMass(i, m, principalInertia[i].mean());
+  setAngularVelocity(i, angularVelocity[i]);  // L = I_world w of the current spin
+}
+
+void Particles::setAngularVelocity(std::size_t i, const Vec3& w) {
+  angularVelocity[i] = w;
+  if (shape[i] == Shape::Ellipsoid) {
+    const Quat& q = orientation[i];
+    angularMomentum[i] = q * principalInertia[i].cwiseProduct(q.conjugate() * w);
+  }
+}
+
+bool Particles::anyEllipsoid() const {
+  for (Shape s : shape)
+    if (s == Shape::Ellipsoid) return true;
+  return false;
 }
 
 void Particles::setSphereRadius(std::size_t i, double r, double density) {
   const double m = 4.0 / 3.0 * kPi * r * r * r * density;
   radius[i] = r;
   semiAxes[i] = Vec3::Constant(r);
+  equivalentRadius[i] = r;
   setMass(i, m, 0.4 * m * r * r);
+  principalInertia[i] = Vec3::Constant(inertia[i]);
 }
 
 double Particles::solidVolume() const {
@@ -68,6 +114,9 @@ void Particles::permute(const std::vector<std::uint32_t>& order) {
   applyOrder(invInertia, order);
   applyOrder(rollingFriction, order);
   applyOrder(image, order);
+  applyOrder(principalInertia, order);
+  applyOrder(angularMomentum, order);
+  applyOrder(equivalentRadius, order);
 }
 
 void Particles::saveState(std::ostream& out) const {
@@ -86,6 +135,8 @@ void Particles::saveState(std::ostream& out) const {
   putVector(out, inertia);
   putVector(out, rollingFriction);
   putVector(out, image);
+  putVector(out, principalInertia);
+  putVector(out, angularMomentum);
 }
 
 void Particles::loadState(std::istream& in) {
@@ -104,6 +155,12 @@ void Particles::loadState(std::istream& in) {
   getVector(in, inertia);
   getVector(in, rollingFriction);
   getVector(in, image);
+  getVector(in, principalInertia);
+  getVector(in, angularMomentum);
+  // Derived: the equivalent radius of each shape.
+  equivalentRadius.resize(semiAxes.size());
+  for (std::size_t i = 0; i < semiAxes.size(); ++i)
+    equivalentRadius[i] = shape[i] == Shape::Sphere ? radius[i] : geometry::equivalentRadius(semiAxes[i]);
   invMass.resize(mass.size());
   invInertia.resize(inertia.size());
   for (std::size_t i = 0; i < mass.size(); ++i) {

@@ -32,7 +32,14 @@ struct Particles {
   std::vector<double> radius;   // [m] sphere radius; for other shapes the bounding radius
   std::vector<Vec3> semiAxes;   // [m] along the body axes; (r, r, r) for spheres
   std::vector<double> mass;     // [kg]
-  std::vector<double> inertia;  // [kg m^2], 2/5 m R^2 for spheres
+  std::vector<double> inertia;  // [kg m^2], 2/5 m R^2 for spheres (ellipsoids: the mean principal moment)
+  // Non-spherical bodies: principal moments along the body axes [kg m^2] ((I, I, I) for spheres),
+  // the world angular momentum at mid-step [kg m^2/s] that their rotation integrator keeps exact
+  // (zero for spheres, which need none), and the equivalent radius (abc)^(1/3) the contact
+  // stiffness is computed from ([O]; the radius itself for spheres).
+  std::vector<Vec3> principalInertia;
+  std::vector<Vec3> angularMomentum;
+  std::vector<double> equivalentRadius;
   // 1/m and 1/I, derived from mass and inertia (not saved in checkpoints; rebuilt on load): the
   // integrator multiplies instead of dividing twice per particle and step.
   std::vector<double> invMass;
@@ -47,6 +54,16 @@ struct Particles {
   // Appends a sphere; its id is `newId`, or its index when newId is kNoId.
   static constexpr std::uint64_t kNoId = ~std::uint64_t{0};
   void addSphere(const Vec3& x, double r, double density, std::uint64_t newId = kNoId);
+  // Appends an ellipsoid of semi-axes a >= b >= c along its body x, y, z axes, orientation q (body
+  // to world), at rest.
+  void addEllipsoid(const Vec3& x, const Vec3& semiAxes, const Quat& q, double density, std::uint64_t newId = kNoId);
+  // Gives particle i new semi-axes (a sphere when all three are equal) keeping its density:
+  // mass, inertia and the angular momentum of its current spin follow.
+  void setShape(std::size_t i, const Vec3& semiAxes, double density);
+  bool anyEllipsoid() const;
+  // Sets particle i's angular velocity [rad/s]; for an ellipsoid also its angular momentum, which
+  // is the state its integrator advances (writing angularVelocity alone would be overwritten).
+  void setAngularVelocity(std::size_t i, const Vec3& w);
   // Overrides a particle's mass and moment of inertia (keeps 1/m and 1/I in step).
   void setMass(std::size_t i, double m, double inertiaValue) {
     mass[i] = m;

@@ -10,6 +10,8 @@
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/state_io.hpp"
+#include "core/rigid_rotation.hpp"
+#include "geometry/ellipsoid_shape.hpp"
 
 namespace grainlab {
 
@@ -78,30 +80,62 @@ void Simulation::wrapIntoCell() {
       for (int a = 0; a < 3; ++a) particles.image[i][a] += wrap[i][a];
     }
   }
-  if (any) contacts.sphereSphere.applyWrap(wrap);
+  if (any) contacts.forEachPair([&](auto& list) { list.applyWrap(wrap); });
 }
 
 template <bool Periodic>
 void Simulation::computeContactsFor() {
-  const ContactContext ctx{particles, model, box, cell, dt};
+  // Shape matrices of the step, once per ellipsoid, shared by its contacts.
+  const bool ellipsoids = !contacts.ellipsoidEllipsoid.a.empty() || !contacts.sphereEllipsoid.a.empty() ||
+                          !contacts.ellipsoidWall.a.empty();
+  if (ellipsoids) {
+    shapeMatrices_.resize(particles.size());
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      if (particles.shape[i] == Shape::Ellipsoid)
+        shapeMatrices_[i] = geometry::shapeMatrix(particles.semiAxes[i], particles.orientation[i]);
+  }
+  const ContactContext ctx{particles, model, box, cell, dt, &shapeMatrices_};
   auto& pairs = contacts.sphereSphere;
   auto& walls = contacts.sphereWall;
-  ChunkedSums pairSums(pairs.size(), Periodic ? kContactSums : 2), wallSums(walls.size(), 2);
-  const bool writeAllPairs = pairs.slotsStale, writeAllWalls = walls.slotsStale;
-  pairs.slotsStale = false;
-  walls.slotsStale = false;
+  auto& ee = contacts.ellipsoidEllipsoid;
+  auto& se = contacts.sphereEllipsoid;
+  auto& ew = contacts.ellipsoidWall;
+  const int pairTerms = Periodic ? kContactSums : 2;
+  ChunkedSums pairSums(pairs.size(), pairTerms), wallSums(walls.size(), 2), eeSums(ee.size(), pairTerms),
+      seSums(se.size(), pairTerms), ewSums(ew.size(), 2);
+  // Every slot is written once after the list changed; then apart pairs are skipped.
+  std::array<bool, 5> writeAll{};
+  int k = 0;
+  contacts.forEach([&](auto& list) {
+    writeAll[k++] = list.slotsStale;
+    list.slotsStale = false;
+  });
 #pragma omp parallel
   {
-    evaluateContacts<SphereSphere, Periodic>(pairs, ctx, pairSums, writeAllPairs);
-    if constexpr (!Periodic) evaluateContacts<SpherePlane, false>(walls, ctx, wallSums, writeAllWalls);
+    evaluateContacts<SphereSphere, Periodic>(pairs, ctx, pairSums, writeAll[0]);
+    if constexpr (!Periodic) evaluateContacts<SpherePlane, false>(walls, ctx, wallSums, writeAll[1]);
+    if (ellipsoids) {
+      evaluateContacts<EllipsoidEllipsoid, Periodic>(ee, ctx, eeSums, writeAll[2]);
+      evaluateContacts<SphereEllipsoid, Periodic>(se, ctx, seSums, writeAll[3]);
+      if constexpr (!Periodic) evaluateContacts<EllipsoidPlane, false>(ew, ctx, ewSums, writeAll[4]);
+    }
   }
   energy.slip += pairSums.total(kSlip) + wallSums.total(kSlip);
   energy.rolling += pairSums.total(kRoll) + wallSums.total(kRoll);
+  if (ellipsoids) {
+    energy.slip += eeSums.total(kSlip) + seSums.total(kSlip) + ewSums.total(kSlip);
+    energy.rolling += eeSums.total(kRoll) + seSums.total(kRoll) + ewSums.total(kRoll);
+  }
   if constexpr (Periodic) {
     const double v = cell.volume();
-    for (int i = 0; i < 9; ++i) cell.stress(i % 3, i / 3) = pairSums.total(kStress0 + i) / v;
-    for (int i = 0; i < 3; ++i) cell.stiffness[i] = pairSums.total(kStiffness0 + i) / v;
-    for (int i = 0; i < 3; ++i) cell.shearStiffness[i] = pairSums.total(kShearStiffness0 + i) / v;
+    auto total = [&](int term) {
+      double t = pairSums.total(term);
+      if (ellipsoids) t += eeSums.total(term) + seSums.total(term);
+      return t;
+    };
+    for (int i = 0; i < 9; ++i) cell.stress(i % 3, i / 3) = total(kStress0 + i) / v;
+    for (int i = 0; i < 3; ++i) cell.stiffness[i] = total(kStiffness0 + i) / v;
+    for (int i = 0; i < 3; ++i) cell.shearStiffness[i] = total(kShearStiffness0 + i) / v;
   }
 }
 
@@ -143,14 +177,17 @@ void Simulation::measureBoundary() {
     wall.contactStiffness = 0.0;
     wall.contacts = 0;
   }
-  const auto& list = contacts.sphereWall;
-  for (std::size_t c = 0; c < list.size(); ++c) {
-    if (!list.history[c].touching) continue;
-    Wall& wall = box.walls[list.b[c]];
-    wall.normalForce += list.force[c].dot(wall.inwardNormal());
-    wall.contactStiffness += model.wallParams(particles.radius[list.a[c]], wall.tanFriction).kn;
-    ++wall.contacts;
-  }
+  auto sum = [&](const auto& list, const std::vector<double>& radius) {
+    for (std::size_t c = 0; c < list.size(); ++c) {
+      if (!list.history[c].touching) continue;
+      Wall& wall = box.walls[list.b[c]];
+      wall.normalForce += list.force[c].dot(wall.inwardNormal());
+      wall.contactStiffness += model.wallParams(radius[list.a[c]], wall.tanFriction).kn;
+      ++wall.contacts;
+    }
+  };
+  sum(contacts.sphereWall, particles.radius);
+  sum(contacts.ellipsoidWall, particles.equivalentRadius);
 }
 
 void Simulation::controlBoundary() {
@@ -253,6 +290,7 @@ void Simulation::integrateFor() {
   auto& w = particles.angularVelocity;
   const auto& xBuild = broadPhase.positionsAtBuild();
   const double alpha = localDamping;
+  const bool viscous = viscousDamping > 0.0;
   const double h = dt;
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   // Periodic cell: particles move with the homogeneous flow too, x <- x + v h + M x, the same map
@@ -273,28 +311,53 @@ void Simulation::integrateFor() {
     Vec3 f = particles.force[i] + particles.mass[i] * gravity;
     Vec3 t = particles.torque[i];
     Vec3 fd, td;
-    for (int k = 0; k < 3; ++k) {
-      fd[k] = -alpha * std::copysign(std::abs(f[k]), v[i][k]) * (v[i][k] != 0.0);
-      td[k] = -alpha * std::copysign(std::abs(t[k]), w[i][k]) * (w[i][k] != 0.0);
-    }
     const Vec3 vOld = v[i], wOld = w[i];
-    v[i] += (f + fd) * (h * particles.invMass[i]);
-    w[i] += (t + td) * (h * particles.invInertia[i]);
+    if (viscous) {
+      // [O] eq. 3.27-3.28: (p_new - p_old)/dt = F - alpha (p_old + p_new)/2, p = m v or I w (L).
+      const rotation::ViscousKick kick = rotation::viscousMidpointKick(particles.mass[i] * v[i], f, viscousDamping, h);
+      fd = kick.dampingForce;
+      v[i] = kick.momentum * particles.invMass[i];
+    } else {
+      for (int k = 0; k < 3; ++k) fd[k] = -alpha * std::copysign(std::abs(f[k]), v[i][k]) * (v[i][k] != 0.0);
+      v[i] += (f + fd) * (h * particles.invMass[i]);
+    }
+    if (particles.shape[i] == Shape::Ellipsoid) {
+      // Distinct principal moments: the rotational leapfrog of core/rigid_rotation.hpp (Euler's
+      // equations with the gyroscopic term, second order, angular momentum kept exact; local damping
+      // on the torque against the mid-step spin, as for spheres).
+      const rotation::LeapfrogRotation r = rotation::leapfrogRotationWithMomentum(
+          q[i], w[i], particles.angularMomentum[i], particles.principalInertia[i], t, h,
+          viscous ? rotation::Damping::Viscous : (alpha > 0.0 ? rotation::Damping::Local : rotation::Damping::None),
+          viscous ? viscousDamping : alpha);
+      td = r.dampingTorque;
+      w[i] = r.step.angularVelocity;
+      q[i] = r.step.orientation;
+      particles.angularMomentum[i] = r.angularMomentum;
+    } else {
+      if (viscous) {
+        const rotation::ViscousKick kick = rotation::viscousMidpointKick(particles.inertia[i] * w[i], t, viscousDamping, h);
+        td = kick.dampingForce;
+        w[i] = kick.momentum * particles.invInertia[i];
+      } else {
+        for (int k = 0; k < 3; ++k) td[k] = -alpha * std::copysign(std::abs(t[k]), w[i][k]) * (w[i][k] != 0.0);
+        w[i] += (t + td) * (h * particles.invInertia[i]);
+      }
+      const double wNorm = w[i].norm();
+      if (wNorm > 0.0) {
+        // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
+        const Vec3 half = 0.5 * h * w[i];
+        Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
+        // |qn|^2 = 1 + eps with eps ~ |w dt|^2 / 4 (~1e-10): 1/sqrt(1 + eps) by its series
+        // 1 - eps/2 + 3 eps^2/8, exact to round-off below 1e-6; the square root otherwise.
+        const double eps = qn.coeffs().squaredNorm() - 1.0;
+        qn.coeffs() *= std::abs(eps) < 1e-6 ? 1.0 - 0.5 * eps + 0.375 * eps * eps : 1.0 / std::sqrt(1.0 + eps);
+        q[i] = qn;
+      }
+    }
     // Work of the damping forces over the step, with the mean of old and new velocities.
     work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
     if constexpr (Periodic) x[i] += v[i] * h + flowStep * x[i];
     else x[i] += v[i] * h;
-    const double wNorm = w[i].norm();
-    if (wNorm > 0.0) {
-      // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
-      const Vec3 half = 0.5 * h * w[i];
-      Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
-      // |qn|^2 = 1 + eps with eps ~ |w dt|^2 / 4 (~1e-10): 1/sqrt(1 + eps) by its series
-      // 1 - eps/2 + 3 eps^2/8, exact to round-off below 1e-6; the square root otherwise.
-      const double eps = qn.coeffs().squaredNorm() - 1.0;
-      qn.coeffs() *= std::abs(eps) < 1e-6 ? 1.0 - 0.5 * eps + 0.375 * eps * eps : 1.0 / std::sqrt(1.0 + eps);
-      q[i] = qn;
-    }
     if (!xBuild.empty()) {
       if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
       else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
@@ -379,7 +442,9 @@ void Simulation::loadCell(std::istream& in) {
 
 std::size_t Simulation::touchingPairs() const {
   std::size_t count = 0;
-  for (const auto& h : contacts.sphereSphere.history) count += h.touching;
+  contacts.forEachPair([&](const auto& list) {
+    for (const auto& h : list.history) count += h.touching;
+  });
   return count;
 }
 
@@ -411,6 +476,7 @@ void Simulation::saveState(std::ostream& out) const {
   put(out, gravity);
   put(out, dt);
   put(out, localDamping);
+  put(out, viscousDamping);
   put(out, stepCount);
   put(out, time);
   put(out, rebuildDue_);
@@ -430,6 +496,7 @@ void Simulation::loadState(std::istream& in) {
   get(in, gravity);
   get(in, dt);
   get(in, localDamping);
+  get(in, viscousDamping);
   get(in, stepCount);
   get(in, time);
   get(in, rebuildDue_);

@@ -19,6 +19,7 @@
 #include "core/periodic_cell.hpp"
 #include "core/servo_settings.hpp"
 #include "core/walls.hpp"
+#include "geometry/ellipsoid_shape.hpp"
 
 namespace grainlab {
 
@@ -47,6 +48,9 @@ class Simulation {
   Vec3 gravity = Vec3::Zero();  // [m/s^2]; off in the triaxial tests of [W]
   double dt = 0.0;            // [s]
   double localDamping = 0.3;  // Cundall alpha [-]
+  // [O]'s viscous mass- and inertia-proportional damping alpha [1/s] (PHYSICS.md §4), integrated by
+  // the midpoint rule; when > 0 it replaces the local damping.
+  double viscousDamping = 0.0;
   long stepCount = 0;
   double time = 0.0;          // [s]
 
@@ -100,6 +104,7 @@ class Simulation {
   void saveCell(std::ostream& out) const;
   void loadCell(std::istream& in);
   bool rebuildDue_ = true;
+  std::vector<geometry::Sym3> shapeMatrices_;  // scratch of the contact stage (ellipsoids)
 };
 
 }  // namespace grainlab

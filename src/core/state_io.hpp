@@ -148,6 +148,18 @@ inline void get(std::istream& in, contact::ContactHistory& h) {
   get(in, h.touching);
 }
 
+static_assert(fieldCount<contact::EllipsoidHistory>() == 3, "a field was added to EllipsoidHistory: write and read it below");
+inline void put(std::ostream& out, const contact::EllipsoidHistory& h) {
+  put(out, static_cast<const contact::ContactHistory&>(h));
+  put(out, h.lambda);
+  put(out, h.potentialLength);
+}
+inline void get(std::istream& in, contact::EllipsoidHistory& h) {
+  get(in, static_cast<contact::ContactHistory&>(h));
+  get(in, h.lambda);
+  get(in, h.potentialLength);
+}
+
 // Bytes one element occupies in the state (for the bounds check of a vector's count).
 template <class T>
 constexpr std::size_t encodedSize() {
@@ -156,6 +168,7 @@ constexpr std::size_t encodedSize() {
   else if constexpr (std::is_same_v<T, Quat>) return 4 * sizeof(double);
   else if constexpr (std::is_same_v<T, Mat3>) return 9 * sizeof(double);
   else if constexpr (std::is_same_v<T, contact::ContactHistory>) return 9 * sizeof(double) + 1;
+  else if constexpr (std::is_same_v<T, contact::EllipsoidHistory>) return 11 * sizeof(double) + 1;
   else return sizeof(T);
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <stdexcept>
 
 #include "core/errors.hpp"
@@ -41,6 +42,8 @@ void Simulation::validateState() const {
   sameSize(P.inertia, n, "inertia");
   sameSize(P.rollingFriction, n, "rolling friction");
   sameSize(P.image, n, "image");
+  sameSize(P.principalInertia, n, "principal inertia");
+  sameSize(P.angularMomentum, n, "angular momentum");
   for (std::size_t i = 0; i < n; ++i) {
     if (!finite(P.position[i]) || !finite(P.velocity[i]) || !finite(P.angularVelocity[i]) ||
         !P.orientation[i].coeffs().allFinite())
@@ -93,8 +96,19 @@ void Simulation::validateState() const {
       bad(fmt::format("{} contact arrays of unequal length", Kind::kName));
     for (std::size_t c = 0; c < m; ++c) {
       if (list.a[c] >= n) bad(fmt::format("{} contact {}: particle index out of range", Kind::kName, c));
-      if (Kind::kPlane ? list.b[c] >= 6 : (list.b[c] >= n || list.b[c] <= list.a[c]))
+      if (Kind::kPlane ? list.b[c] >= 6 : (list.b[c] >= n || (Kind::kIndexOrdered && list.b[c] <= list.a[c])))
         bad(fmt::format("{} contact {}: second body out of range", Kind::kName, c));
+      // Each kind holds the shapes it is for.
+      const Shape first = std::is_same_v<Kind, EllipsoidEllipsoid> || std::is_same_v<Kind, EllipsoidPlane>
+                              ? Shape::Ellipsoid : Shape::Sphere;
+      const Shape second = std::is_same_v<Kind, SphereSphere> ? Shape::Sphere : Shape::Ellipsoid;
+      if (P.shape[list.a[c]] != first || (!Kind::kPlane && P.shape[list.b[c]] != second))
+        bad(fmt::format("{} contact {}: bodies of another shape", Kind::kName, c));
+      if constexpr (std::is_same_v<typename Kind::History, contact::EllipsoidHistory>) {
+        const auto& h = list.history[c];
+        if (!(h.lambda >= 0.0 && h.lambda <= 1.0) || !(h.potentialLength >= 0.0) || !std::isfinite(h.potentialLength))
+          bad(fmt::format("{} contact {}: lambda or potential length out of range", Kind::kName, c));
+      }
       if (c > 0 && !(list.key(c - 1) < list.key(c))) bad(fmt::format("{} contacts not sorted", Kind::kName));
       const auto& h = list.history[c];
       if (!finite(h.shearForce) || !finite(h.moment) || !finite(h.prevNormal) || !finite(list.force[c]))

@@ -294,6 +294,49 @@ void refuseNulCharacters(const toml::node& node, const std::string& key) {
   }
 }
 
+lab::ShapeConfig parseShape(Section& s) {
+  lab::ShapeConfig shape;
+  const toml::node* node = s.raw("shape");
+  if (!node) return shape;
+  const std::string key = s.path("shape");
+  if (!node->is_table())
+    fail(key, show(*node), "must be an inline table, e.g. { type = \"ellipsoid\", elongation = 0.7, flatness = 1.0 }");
+  const toml::table& t = *node->as_table();
+  for (const auto& [k, v] : t) {
+    const std::string name(k.str());
+    if (name != "type" && name != "elongation" && name != "flatness" && name != "orientation" && name != "fraction" &&
+        name != "eccentricity_step")
+      fail(key + "." + name, show(v), "unknown key; allowed: type, elongation, flatness, orientation, fraction, eccentricity_step");
+  }
+  auto number = [&](const char* k, double def, double lo, double hi, const char* allowed) {
+    const toml::node* n = t.get(k);
+    if (!n) return def;
+    const std::optional<double> v = n->value<double>();
+    if (!n->is_number() || !v || !std::isfinite(*v) || *v <= lo || *v > hi) fail(key + "." + k, show(*n), allowed);
+    return *v;
+  };
+  auto text = [&](const char* k, const std::string& def, const std::vector<std::string>& allowed) {
+    const toml::node* n = t.get(k);
+    if (!n) return def;
+    const std::string v = n->is_string() ? n->value<std::string>().value() : std::string();
+    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "\"" : ", \"") + a + "\"";
+      fail(key + "." + k, show(*n), "allowed: " + list);
+    }
+    return v;
+  };
+  shape.type = text("type", shape.type, {"sphere", "ellipsoid"});
+  shape.elongation = number("elongation", shape.elongation, 0.0, 1.0, "must be in (0, 1] (b/a)");
+  shape.flatness = number("flatness", shape.flatness, 0.0, 1.0, "must be in (0, 1] (c/b)");
+  shape.orientation = text("orientation", shape.orientation, {"random", "aligned-x"});
+  shape.fraction = number("fraction", shape.fraction, 0.0, 1.0, "must be in (0, 1] (share of ellipsoids by number)");
+  shape.eccentricityStep = number("eccentricity_step", shape.eccentricityStep, 0.0, 0.5, "must be in (0, 0.5]");
+  if (shape.type == "ellipsoid" && shape.elongation == 1.0 && shape.flatness == 1.0)
+    fail(key + ".elongation", "1", "an ellipsoid needs elongation < 1 or flatness < 1 (else type = \"sphere\")");
+  return shape;
+}
+
 }  // namespace
 
 std::string configBaseDir(const std::string& source) {
@@ -415,9 +458,20 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
   c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
-  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth"});
+  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice"});
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
+  c.sample.shape = parseShape(s);
+  if (c.sample.method == "lattice") {
+    const long n = c.sample.nParticles;
+    const long side = std::lround(std::cbrt(static_cast<double>(n)));
+    if (side * side * side != n)
+      fail("sample.n_particles", std::to_string(n), "must be a cube n^3 (e.g. 512, 1000) for sample.method = \"lattice\"");
+  }
+  if (c.sample.shape.type == "ellipsoid" && c.sample.method == "compaction" && !c.sample.prepFrictionDeg)
+    fail("sample.prep_friction_deg", "\"auto\"",
+         "cannot search e0 for ellipsoids (their frictionless growth after compaction changes e); give an angle, "
+         "or sample.method = \"growth\" or \"lattice\"");
   s.finish();
 
   Section ct(root, "contact");
@@ -429,6 +483,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.contact.eta = ct.number("eta", c.contact.eta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.wallFrictionDeg = ct.number("wall_friction_deg", c.contact.wallFrictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   c.contact.momentLimit = ct.string("moment_limit", c.contact.momentLimit, {"mean-radius", "yade"});
+  if (ct.raw("kn"))
+    c.contact.kn = ct.number("kn", 0.0, 0.0, 1e15, true, false, "must be > 0 [N/m] (a constant normal stiffness)");
   const bool linear = c.contact.model == "rolling-linear";
   const toml::node* mu = ct.raw("rolling_friction");
   const toml::node* sph = ct.raw("sphericity");
@@ -499,6 +555,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
 
   Section so(root, "solver");
   c.solver.damping = so.number("damping", c.solver.damping, 0.0, 1.0, false, true, "must be in [0, 1)");
+  c.solver.viscousDamping = so.number("viscous_damping", c.solver.viscousDamping, 0.0, 1e9, false, false,
+                                      "must be >= 0 [1/s] ([O]'s viscous damping; 0: local damping)");
   c.solver.dtFactor = so.number("dt_factor", c.solver.dtFactor, 0.0, 1.0, true, false, "must be in (0, 1] (fraction of the critical time step)");
   if (so.raw("dt"))
     c.solver.dt = so.number("dt", 0.0, 0.0, 1.0, true, false, "must be > 0 [s] (and at most the critical time step)");
@@ -559,6 +617,12 @@ toml::table resolvedTable(const lab::RunConfig& c) {
       {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
       {"method", c.sample.method},
       {"growth_rate", c.sample.growthRate},
+      {"shape", toml::table{{"type", c.sample.shape.type},
+                            {"elongation", c.sample.shape.elongation},
+                            {"flatness", c.sample.shape.flatness},
+                            {"orientation", c.sample.shape.orientation},
+                            {"fraction", c.sample.shape.fraction},
+                            {"eccentricity_step", c.sample.shape.eccentricityStep}}},
   };
   if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
   else sample.insert("prep_friction_deg", "auto");
@@ -567,6 +631,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                       {"beta", c.contact.beta},         {"eta", c.contact.eta},
                       {"wall_friction_deg", c.contact.wallFrictionDeg},
                       {"moment_limit", c.contact.momentLimit}};
+  if (c.contact.kn) contact.insert("kn", *c.contact.kn);
   if (c.contact.model == "rolling-linear") {
     if (c.contact.sphericity) {
       const auto& sc = *c.contact.sphericity;
@@ -586,6 +651,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);
   else test.insert("shear_strain_rate", "auto");
   toml::table solver{{"damping", c.solver.damping},
+                     {"viscous_damping", c.solver.viscousDamping},
                      {"dt_factor", c.solver.dtFactor},
                      {"force_dt", c.solver.forceDt},
                      {"threads", c.solver.threads},

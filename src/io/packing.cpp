@@ -358,9 +358,8 @@ void simulationFromPacking(const PackingData& p, double density, Simulation& sim
   if (p.particles.size() < 2) throw InputError(fmt::format("{}: fewer than two particles", subject));
   Particles particles;
   for (const PackedParticle& q : p.particles) {
-    if (q.ellipsoid)
-      throw InputError(fmt::format("{}: particle id {} is an ellipsoid: not supported by this build yet", subject, q.id));
-    particles.addSphere(q.position, q.semiAxes[0], density, q.id);
+    if (q.ellipsoid) particles.addEllipsoid(q.position, q.semiAxes, q.orientation, density, q.id);
+    else particles.addSphere(q.position, q.semiAxes[0], density, q.id);
   }
   sim.particles = std::move(particles);
   if (p.periodic) {

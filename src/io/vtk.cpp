@@ -27,6 +27,19 @@ std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   v.pointVector("angular_velocity", P.angularVelocity);
   v.pointScalar("contacts", contacts);
   v.pointScalar("mu_r", P.rollingFriction);
+  // Shape and orientation: the semi-axes, each body axis scaled by its semi-axis (for arrow glyphs
+  // of the long axis), and Q diag(a, b, c) Q^T, whose Tensor Glyph in ParaView is the grain itself.
+  std::vector<Vec3> semiAxes(n), axisA(n);
+  std::vector<Mat3> shapeTensor(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Mat3 r = P.orientation[i].toRotationMatrix();
+    semiAxes[i] = P.semiAxes[i];
+    axisA[i] = P.semiAxes[i][0] * r.col(0);
+    shapeTensor[i] = r * P.semiAxes[i].asDiagonal() * r.transpose();
+  }
+  v.pointVector("semi_axes", semiAxes);
+  v.pointVector("axis_a", axisA);
+  v.pointTensor("shape_tensor", shapeTensor);
   for (const auto& [name, values] : extra.scalars) v.pointScalar(name, values);
   for (const auto& [name, values] : extra.vectors) v.pointVector(name, values);
   return v.text();

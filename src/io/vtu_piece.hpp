@@ -25,6 +25,15 @@ class VtuPiece {
   }
   void pointScalar(const std::string& name, const std::vector<double>& v) { pointData_ += array(name, v, 1); }
   void pointVector(const std::string& name, const std::vector<Vec3>& v) { pointData_ += array(name, flatten(v), 3); }
+  // A 3x3 tensor per point, row-major (ParaView's Tensor Glyph filter draws it as an ellipsoid).
+  void pointTensor(const std::string& name, const std::vector<Mat3>& v) {
+    std::vector<double> flat;
+    flat.reserve(9 * v.size());
+    for (const Mat3& m : v)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) flat.push_back(m(r, c));
+    pointData_ += array(name, flat, 9);
+  }
   void cellScalar(const std::string& name, const std::vector<double>& v) { cellData_ += array(name, v, 1); }
   void cellVector(const std::string& name, const std::vector<Vec3>& v) { cellData_ += array(name, flatten(v), 3); }
 

@@ -67,8 +67,12 @@ double coordinationNumber(const Simulation& sim) {
 double kineticEnergy(const Simulation& sim) {
   const auto& P = sim.particles;
   double e = 0.0;
-  for (std::size_t i = 0; i < P.size(); ++i)
-    e += 0.5 * P.mass[i] * P.velocity[i].squaredNorm() + 0.5 * P.inertia[i] * P.angularVelocity[i].squaredNorm();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    // An ellipsoid's rotational energy is w . L / 2 with its (exact) angular momentum.
+    const double rotation = P.shape[i] == Shape::Ellipsoid ? 0.5 * P.angularVelocity[i].dot(P.angularMomentum[i])
+                                                           : 0.5 * P.inertia[i] * P.angularVelocity[i].squaredNorm();
+    e += 0.5 * P.mass[i] * P.velocity[i].squaredNorm() + rotation;
+  }
   return e;
 }
 
@@ -76,7 +80,7 @@ double elasticEnergy(const Simulation& sim) {
   double e = 0.0;
   forEachTouchingContact(sim, [&](const ContactView& c) {
     const contact::PairParams& pp = c.params;
-    double u = 0.5 * pp.kn * c.overlap * c.overlap;
+    double u = c.normalEnergy;
     if (pp.ks > 0.0) u += 0.5 * c.history->shearForce.squaredNorm() / pp.ks;
     if (pp.kr > 0.0) u += 0.5 * c.history->moment.squaredNorm() / pp.kr;
     e += u;

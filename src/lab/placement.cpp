@@ -86,4 +86,13 @@ void placeLoose(std::vector<double> diameters, double density, double voidRatio,
   else sim.box.setBounds(Vec3::Zero(), Vec3::Constant(side));
 }
 
+void placeLattice(int n, double d, double density, Simulation& sim) {
+  sim.particles = Particles{};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) sim.particles.addSphere(Vec3(i + 0.5, j + 0.5, k + 0.5) * d, 0.5 * d, density);
+  if (sim.boundary == Boundary::Periodic) sim.cell.setBox(Vec3::Constant(n * d));
+  else sim.box.setBounds(Vec3::Zero(), Vec3::Constant(n * d));
+}
+
 }  // namespace grainlab::lab

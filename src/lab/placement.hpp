@@ -15,4 +15,8 @@ namespace grainlab::lab {
 // as sim.boundary says.
 void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim);
 
+// [O] §5.1: n^3 equal spheres of diameter d on a simple cubic lattice of spacing d (just touching),
+// filling the cube of side n d: the cell (periodic) or the box of walls.
+void placeLattice(int n, double d, double density, Simulation& sim);
+
 }  // namespace grainlab::lab

@@ -10,6 +10,7 @@
 #include "lab/measurements.hpp"
 #include "lab/placement.hpp"
 #include "lab/protocols.hpp"
+#include "geometry/ellipsoid_shape.hpp"
 
 namespace grainlab::lab {
 
@@ -24,8 +25,9 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   setFriction(muDeg);
   if (config_.sample.method == "growth") steps += growRadii();
   steps += consolidate(config_.test.confiningPressure,
-                       config_.sample.method == "growth" ? std::string("equilibrium after growth")
-                                                         : fmt::format("compaction (mu_prep {:.1f} deg)", muDeg));
+                       config_.sample.method == "compaction" ? fmt::format("compaction (mu_prep {:.1f} deg)", muDeg)
+                                                             : std::string("isotropic compression"));
+  if (config_.sample.shape.type == "ellipsoid") steps += growShapes();
   steps += rampStiffness();
   configureSolver(config_, sim_);
   steps += consolidate(config_.test.confiningPressure, "equilibrium at full stiffness and friction");
@@ -39,7 +41,15 @@ PreparationResult Laboratory::prepare() {
   const std::vector<double> diameters = sampleDiameters(config_.sample.grading, config_.sample.nParticles, rng);
   result.grading = gradingStats(diameters);
   d50_ = result.grading.d50;
-  placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng, sim_);
+  if (config_.sample.method == "lattice") {
+    // Equal spheres of the grading's d50 ([O]'s N = n^3 equal grains).
+    const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(config_.sample.nParticles))));
+    placeLattice(n, result.grading.d50, config_.sample.density, sim_);
+    result.grading = gradingStats(std::vector<double>(sim_.particles.size(), result.grading.d50));
+    d50_ = result.grading.d50;
+  } else {
+    placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng, sim_);
+  }
   records_ = GrainRecords{};
   records_.sphericity = assignRollingFriction(config_, sim_.particles);
   configureSolver(config_, sim_);
@@ -73,8 +83,8 @@ PreparationResult Laboratory::prepare() {
     return e;
   };
 
-  if (config_.sample.method == "growth") {
-    trial(0.0);  // frictionless growth: the e0 reached is the result, not a target
+  if (config_.sample.method != "compaction") {
+    trial(0.0);  // frictionless growth or lattice: the e0 reached is the result, not a target
   } else if (config_.sample.prepFrictionDeg) {
     trial(*config_.sample.prepFrictionDeg);
   } else {
@@ -121,6 +131,53 @@ PreparationResult Laboratory::prepare() {
   records_.reset(sim_);
   result.state = equilibriumState();
   return result;
+}
+
+long Laboratory::growShapes() {
+  const ShapeConfig& shape = config_.sample.shape;
+  const double density = config_.sample.density;
+  const double pressure = config_.test.confiningPressure;
+  Particles& P = sim_.particles;
+  const std::size_t n = P.size();
+  // Which grains grow, and their orientations: a stream of their own, so that the grading and the
+  // placement do not change with the shape.
+  Rng rng(config_.sample.seed ^ 0x5851f42d4c957f2dull);
+  std::vector<char> grows(n);
+  std::vector<Quat> orientation(n, Quat::Identity());
+  for (std::size_t i = 0; i < n; ++i) {
+    grows[i] = shape.fraction >= 1.0 || rng.uniform() < shape.fraction;
+    if (shape.orientation == "random") {
+      // A uniformly random rotation (Shoemake 1992).
+      const double u1 = rng.uniform(), u2 = 2.0 * kPi * rng.uniform(), u3 = 2.0 * kPi * rng.uniform();
+      orientation[i] = Quat(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
+                            std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
+    }
+  }
+  std::vector<double> radius0(n);
+  for (std::size_t i = 0; i < n; ++i) radius0[i] = P.equivalentRadius[i];
+  // Eccentricity (a - b)/(a + b) of the final shape, reached in equal steps of at most
+  // eccentricity_step; the flatness goes from 1 to its final value in the same steps.
+  const double eFinal = (1.0 - shape.elongation) / (1.0 + shape.elongation);
+  const int stages = std::max(1, static_cast<int>(std::ceil(std::max(eFinal, 1.0 - shape.flatness) / shape.eccentricityStep - 1e-9)));
+  const double friction = sim_.model.tanFriction;
+  sim_.model.tanFriction = 0.0;  // [O]: grains grow without friction
+  long steps = 0;
+  for (int k = 1; k <= stages; ++k) {
+    const double f = static_cast<double>(k) / stages;
+    const double e = f * eFinal;
+    const double elr = (1.0 - e) / (1.0 + e), flr = 1.0 + f * (shape.flatness - 1.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!grows[i]) continue;
+      if (k == 1) P.orientation[i] = orientation[i];
+      P.setShape(i, geometry::semiAxesFromOuadfel(radius0[i], elr, flr), density);
+    }
+    // New sizes: new skin and lists; the critical step falls as the grains elongate.
+    sim_.initialise(config_.solver.skinFraction);
+    sim_.dt = config_.solver.dtFactor * sim_.criticalTimeStep();
+    steps += consolidate(pressure, fmt::format("shape growth {}/{} (eccentricity {:.3f})", k, stages, e));
+  }
+  sim_.model.tanFriction = friction;
+  return steps;
 }
 
 PreparationResult Laboratory::adoptPacking(Simulation packed) {

@@ -29,6 +29,8 @@ void configureSolver(const RunConfig& c, Simulation& sim) {
   sim.model.tanFriction = std::tan(degToRad(c.contact.frictionDeg));
   for (Wall& w : sim.box.walls) w.tanFriction = std::tan(degToRad(c.contact.wallFrictionDeg));
   sim.localDamping = c.solver.damping;
+  sim.viscousDamping = c.solver.viscousDamping;
+  sim.model.constantKn = c.contact.kn.value_or(0.0);
   sim.servo.gain = c.solver.servoGain;
   sim.servo.integralSteps = c.solver.servoIntegralSteps;
   sim.servo.maxSpeed = c.solver.servoMaxSpeed;

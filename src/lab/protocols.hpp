@@ -173,6 +173,9 @@ class Laboratory {
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();
   long growRadii();
+  // Frictionless growth of the grains chosen to be ellipsoids from their equal-volume spheres to
+  // sample.shape, in steps of eccentricity with the boundary holding p after each ([O] §5.2-5.3).
+  long growShapes();
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
   // Current strain of the test: axial strain, or gamma in simple shear.
   double testStrain() const;

@@ -19,6 +19,17 @@ struct GradingConfig {
   std::string file;                               // (list) one diameter [m] per line/row
 };
 
+// Grain shape ([O], PHYSICS.md §1): spheres, or triaxial ellipsoids a >= b >= c of the same volume
+// as the sphere drawn from the grading (equivalent radius), grown from it at the end of preparation.
+struct ShapeConfig {
+  std::string type = "sphere";      // "sphere" | "ellipsoid"
+  double elongation = 1.0;          // b/a (<= 1); [O]'s elr
+  double flatness = 1.0;            // c/b (<= 1); [O]'s flr; 1 for prolate spheroids
+  std::string orientation = "random";  // long axes "random" or all "aligned-x" (inherent anisotropy)
+  double fraction = 1.0;            // share of the grains (by number) that are ellipsoids; the rest stay spheres
+  double eccentricityStep = 0.01;   // growth in steps of this eccentricity (a - b)/(a + b), relaxed after each
+};
+
 struct SampleConfig {
   int nParticles = 2000;
   GradingConfig grading;
@@ -36,8 +47,11 @@ struct SampleConfig {
   // "compaction": the boundary's servo compacts the loose sample with the preparation friction
   // (searched to meet e0 when prep_friction_deg is "auto"); "growth": frictionless radius growth with
   // the boundary held still up to the confining pressure (the densest state; e0 is a result).
+  // "lattice" ([O] §5.1): equal spheres of diameter d50 on a simple cubic lattice (n_particles a
+  // cube), compressed isotropically without friction (coordination 6).
   std::string method = "compaction";
   double growthRate = 2e-5;           // relative radius growth per step (method "growth")
+  ShapeConfig shape;
 };
 
 struct SphericityConfig {
@@ -58,6 +72,9 @@ struct ContactConfig {
   // "mean-radius": [W]'s |M| <= eta (RA+RB)/2 |Fn|; "yade": YADE's eta min(RA,RB) |Fn| on bending and
   // twisting separately (for comparisons with YADE).
   std::string momentLimit = "mean-radius";
+  // A constant normal stiffness Kn [N/m] for every contact (walls too), Ks = poisson Kn, as [O]
+  // used; unset: Kn from Ec and the (equivalent) radii.
+  std::optional<double> kn;
   // rolling-linear only: a uniform rolling friction, or per-grain values from sphericity.
   double rollingFriction = 0.1;
   std::optional<SphericityConfig> sphericity;
@@ -78,6 +95,7 @@ struct TestConfig {
 
 struct SolverConfig {
   double damping = 0.3;        // Cundall local damping alpha [-]
+  double viscousDamping = 0.0; // [O]'s viscous damping alpha [1/s]; > 0 replaces the local damping
   double dtFactor = 0.5;       // fraction of the critical time step
   std::optional<double> dt;    // explicit time step [s]; refused above critical unless forced
   bool forceDt = false;

@@ -288,12 +288,12 @@ class Cases:
             v1[k] = rng.choice(["nan 0.01 0.01 0.01", "0.001 0.01 0.01", "0.001 0.01 0.01 0.01 5",
                                 "-0.001 0.01 0.01 0.01", "0.001 9 0.01 0.01", "0.001 0.01 x 0.01"])
             return "packing v1", {"p.txt": ("\n".join(v1) + "\n").encode()}, self._packing_args(), ["sample.packing"]
-        else:  # a periodic cell or an ellipsoid: readable, not supported by this build
+        else:  # a periodic cell under a walls test, or an ellipsoid whose axes are out of order
             if rng.random() < 0.5:
                 head[3] = "# boundary periodic"
                 head[4] = "# cell 0.02 0 0 0 0.02 0 0 0 0.02"
             else:
-                rows[0] = rows[0].replace("sphere 0.002 0.002 0.002", "ellipsoid 0.003 0.002 0.001")
+                rows[0] = rows[0].replace("sphere 0.002 0.002 0.002", "ellipsoid 0.001 0.002 0.003")
         return ("packing", {"p.txt": ("\n".join(head + rows) + "\n").encode()}, self._packing_args(),
                 ["sample.packing"])
 

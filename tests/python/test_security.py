@@ -527,10 +527,9 @@ def test_packing_content_is_validated(packing, tmp_path):
     walls = walls_line(packing)
     row = len(header("# boundary walls", walls, "# particles 100")) + 1  # line of the first row
     cases = [
-        (hand_written(packing, lambda r: set_field(r, 4, 1, "ellipsoid")), "", "particle id 4 is an ellipsoid: "
-         "not supported by this build yet"),
         (hand_written(packing, head=header("# boundary periodic", "# cell 0.05 0 0 0 0.05 0 0 0 0.05",
-                                           "# particles 100")), "", "periodic cell is not supported by this build yet"),
+                                           "# particles 100")), "", "the packing's boundary is a periodic cell but "
+         "test.boundary = \"walls\""),
         (hand_written(packing, lambda r: set_field(r, 2, 8, "0.9")), f"line {row + 2}", "unit quaternion"),
         (hand_written(packing, lambda r: set_field(set_field(r, 2, 1, "ellipsoid"), 2, 2, "0.0001")),
          f"line {row + 2}", "a >= b >= c"),
@@ -571,6 +570,12 @@ def test_packing_content_is_validated(packing, tmp_path):
         assert proc.returncode == 2, (fragment, err(proc))
         line = one_line(proc)
         assert "sample.packing" in line and "p.txt" in line and where in line and fragment in line, (fragment, line)
+
+
+def test_packing_with_an_ellipsoid_row_is_accepted(packing, tmp_path):
+    """Ellipsoids are a shape of the engine: a row with a >= b >= c is read as one (no refusal)."""
+    proc = check_packing(tmp_path, hand_written(packing, lambda r: set_field(r, 4, 1, "ellipsoid")))
+    assert proc.returncode == 0, err(proc)
 
 
 def test_packing_bit_flips_and_truncations_are_refused(packing, tmp_path):

@@ -50,8 +50,9 @@ struct ShearStateMembers {
 // added (or removed): write and read it in saveState/loadState (or derive it on load, as invMass
 // is), then update the list below. Trivially copyable structs (Wall, Record, ...) are written whole
 // and need no list; the checkpoint's layout tag (io/checkpoint_file.cpp) changes with their size.
-static_assert(stateio::fieldCount<Particles>() == 16,
-              "Particles changed: update Particles::saveState/loadState and this count (14 saved + invMass, invInertia)");
+static_assert(stateio::fieldCount<Particles>() == 19,
+              "Particles changed: update Particles::saveState/loadState and this count (16 saved + invMass, "
+              "invInertia, equivalentRadius derived)");
 static_assert(stateio::fieldCount<contact::ContactHistory>() == 4, "ContactHistory changed: update state_io.hpp");
 static_assert(sizeof(BroadPhase) ==
                   layoutSize<double, long, std::vector<Vec3>, std::array<double, 6>, Mat3, SpatialGrid>(),
@@ -61,15 +62,17 @@ static_assert(sizeof(ContactList<SphereSphere>) ==
                              std::vector<contact::ContactHistory>, std::vector<Vec3>, std::vector<Vec3>,
                              std::vector<Vec3>, std::vector<std::uint32_t>, std::vector<std::uint32_t>, bool>(),
               "ContactList changed: update ContactList::saveState/loadState and this list (the CSR is derived)");
-static_assert(sizeof(ContactStore) == layoutSize<ContactList<SphereSphere>, ContactList<SpherePlane>>(),
+static_assert(sizeof(ContactStore) ==
+                  layoutSize<ContactList<SphereSphere>, ContactList<SpherePlane>, ContactList<EllipsoidEllipsoid>,
+                             ContactList<SphereEllipsoid>, ContactList<EllipsoidPlane>>(),
               "ContactStore changed: its kinds are saved through forEach; update this list");
 static_assert(stateio::fieldCount<PeriodicCell>() == 16, "PeriodicCell changed: update Simulation::saveCell/loadCell");
 static_assert(stateio::fieldCount<lab::GrainRecords>() == 5, "GrainRecords changed: update its saveState/loadState");
 static_assert(sizeof(Simulation) ==
                   layoutSize<Particles, Boundary, WallBox, PeriodicCell, ContactStore, BroadPhase,
-                             contact::SphereContactModel, ServoSettings, EnergyLedger, Vec3, double, double, long,
-                             double, bool>(),
-              "Simulation changed: update Simulation::saveState/loadState and this list");
+                             contact::SphereContactModel, ServoSettings, EnergyLedger, Vec3, double, double, double,
+                             long, double, bool, std::vector<geometry::Sym3>>(),
+              "Simulation changed: update Simulation::saveState/loadState and this list (shape matrices are scratch)");
 static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
