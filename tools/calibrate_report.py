@@ -121,6 +121,14 @@ def analyse(space, problem, best, neighbours, step):
         table[name] = entry
     out["sensitivity"] = table
     out["statements"] = statements(space, keys, corr, norms, scatter)
+    lower = [e for _, e in neighbours if e["failed"] is None and e["objective"] < best["objective"]]
+    if lower:
+        e = min(lower, key=lambda e: e["objective"])
+        # Within the roughness of a chaotic objective, or a budget too small to converge.
+        out["statements"].append(
+            f"A finite-difference neighbour fits better ({e['name']}: objective {e['objective']:.4g} against "
+            f"{best['objective']:.4g}): the optimum is not resolved more finely than the step; compare the "
+            f"difference with the seed scatter above, or continue with a larger budget.")
     return out
 
 
@@ -278,6 +286,10 @@ def report_markdown(inputs, space, problem, history, best, fit, analysis, meta):
         at = "yes" if best["u"][j] in (0.0, 1.0) else "no"
         lines.append(f"| {p['key']} | {v:.6g} | {_fmt(scatter.get(p['key']))} | [{p['min']:g}, {p['max']:g}]"
                      f"{' log' if p['log'] else ''} | {p['start']:g} | {at} |")
+    n_seeds = len(t["seeds"])
+    if n_seeds < 4:
+        lines += ["", f"The seed scatter is estimated from {n_seeds} seed(s) ({max(n_seeds - 1, 0)} degree(s) of freedom): "
+                  "a rough figure; four or more seeds make it usable."]
     lines += ["", f"Objective {best['objective']:.5g} at {best['name']} (start {history[0]['objective']:.5g}); "
               f"per seed: {', '.join(_fmt(x) for x in best['objective_per_seed'])}.", "",
               "## Fit per target", ""]

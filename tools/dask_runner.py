@@ -32,7 +32,6 @@ EVENT_TOPIC = "grainlab-run-start"
 # Cases whose task raised (e.g. no grainlab executable on that worker) are tried again elsewhere;
 # a worker that dies is handled by the scheduler (distributed.scheduler.allowed-failures).
 TASK_RETRIES = 2
-CONNECT_TIMEOUT_S = 30
 WORKER_WAIT_S = 300
 
 
@@ -57,8 +56,8 @@ def run_case(job):
     """Runs one case (on a Dask worker, or locally when job["mode"] == "local").
 
     job: executable, config, config_text (the config file's text, or None for a preset), name,
-    sets, threads (0: decided here), out (the client's results folder of the case), mode ("local",
-    "shared" or "return"), token (the run's unique id, for the attempt log).
+    sets, threads (0: the config's solver.threads locally, 1 on a worker), out (the client's results
+    folder of the case), mode ("local", "shared" or "return"), token (the run's unique id, for the attempt log).
     Returns a dict: name, exit_code, log, worker, host, files (tar.gz bytes in "return" mode)."""
     worker = None
     if job["mode"] != "local":
@@ -70,7 +69,10 @@ def run_case(job):
         executable = shutil.which("grainlab")
         if executable is None:
             raise RuntimeError(f"{socket.gethostname()}: neither {job['executable']} nor a grainlab on PATH")
-    threads = job["threads"] or (job.get("threads_by_worker", {}).get(worker.address, 1) if worker else 0)
+    # On a cluster a case runs on one thread unless told otherwise: a worker's task slots are its
+    # share of the cores, and OpenMP beyond the free cores runs many times slower (measured 20-30x
+    # on a shared 2-core host: 180-300 s for a 10 s case).
+    threads = job["threads"] or (1 if worker else 0)
     scratch = None
     config = job["config"]
     if not config.startswith("preset:") and not os.path.exists(config):
@@ -156,12 +158,16 @@ class DaskRunner:
 
     def __init__(self, scheduler, shared_out=False, quiet=False):
         import cloudpickle
+        import dask
         from distributed import Client
         # The worker needs run_case but not this file: its module travels by value.
         cloudpickle.register_pickle_by_value(sys.modules[__name__])
         self.shared_out = shared_out
+        # Dask's own connect timeout (distributed.comm.timeouts.connect, 30 s unless configured, e.g.
+        # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
+        timeout = dask.config.get("distributed.comm.timeouts.connect")
         try:
-            self.client = Client(scheduler, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+            self.client = Client(scheduler, timeout=timeout, set_as_default=False)
         except (OSError, TimeoutError) as e:
             raise ConnectionError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
         if not self.client.scheduler_info()["workers"]:
@@ -173,28 +179,15 @@ class DaskRunner:
                 self.client.close()
                 raise ConnectionError(f"no Dask worker joined {scheduler} within {WORKER_WAIT_S} s") from None
 
-    def _threads_by_worker(self):
-        """Threads for a case on each worker when none are given: the host's cores shared among the
-        task slots of every worker on that host (OpenMP beyond the cores runs many times slower)."""
-        workers = self.client.scheduler_info()["workers"]
-        cores = self.client.run(os.cpu_count)
-        slots = {}
-        for info in workers.values():
-            slots[info["host"]] = slots.get(info["host"], 0) + info["nthreads"]
-        return {address: max(1, (cores.get(address) or 1) // max(1, slots[info["host"]]))
-                for address, info in workers.items()}
-
     def run(self, jobs, on_done):
         from distributed import as_completed as dask_completed
-        threads_by_worker = self._threads_by_worker()
         futures = {}
         for job in jobs:
-            task = dict(job, mode="shared" if self.shared_out else "return", threads_by_worker=threads_by_worker,
-                        token=uuid.uuid4().hex)
+            task = dict(job, mode="shared" if self.shared_out else "return", token=uuid.uuid4().hex)
             future = self.client.submit(run_case, task, key=f"grainlab-{job['name']}-{task['token'][:8]}",
                                         pure=False, retries=TASK_RETRIES)
             futures[future] = (job, task["token"])
-        for future in dask_completed(list(futures)):
+        for future in dask_completed(list(futures), loop=self.client.loop):
             job, token = futures[future]
             starts = [msg for _, msg in self.client.get_events(EVENT_TOPIC) if msg.get("token") == token]
             try:
@@ -208,6 +201,10 @@ class DaskRunner:
             result["attempts"] = max(1, len(starts))
             result["workers"] = [msg["worker"] for msg in starts]
             on_done(job, result)
+        if self.shared_out:
+            # What is left there are the folders of attempts whose worker was lost.
+            for parent in {os.path.dirname(job["out"]) for job in jobs}:
+                shutil.rmtree(os.path.join(parent, ".attempts"), ignore_errors=True)
 
     def close(self):
         self.client.close()

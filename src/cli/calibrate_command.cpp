@@ -64,16 +64,20 @@ std::string quoted(const std::vector<std::string>& names) {
   throw InputError(fmt::format("target error: {} = {}: {}", where, cut(value), allowed));
 }
 
-// One table of the target file: typed getters, and every key present must have been read.
+// One table of the target file: typed getters. A misspelt key is an error, not silently ignored,
+// and is reported before anything else about the table (e.g. before "min is required" for "mn").
 class Table {
  public:
-  Table(const toml::table* table, std::string name) : table_(table), name_(std::move(name)) {}
+  Table(const toml::table* table, std::string name, const std::vector<std::string>& known)
+      : table_(table), name_(std::move(name)) {
+    if (!table_) return;
+    for (const auto& [k, v] : *table_)
+      if (std::find(known.begin(), known.end(), std::string(k.str())) == known.end())
+        bad(path(std::string(k.str())), show(v), "unknown key; allowed: " + quoted(known));
+  }
   std::string path(const std::string& key) const { return name_ + "." + key; }
 
-  const toml::node* raw(const std::string& key) {
-    used_.push_back(key);
-    return table_ ? table_->get(key) : nullptr;
-  }
+  const toml::node* raw(const std::string& key) const { return table_ ? table_->get(key) : nullptr; }
   std::optional<double> number(const std::string& key, double lo, double hi, bool loOpen, const std::string& allowed) {
     const toml::node* n = raw(key);
     if (!n) return std::nullopt;
@@ -107,20 +111,10 @@ class Table {
       bad(path(key), show(*n), choices);
     return v;
   }
-  // A misspelt key is an error, not silently ignored.
-  void finish() const {
-    if (!table_) return;
-    for (const auto& [k, v] : *table_) {
-      const std::string key(k.str());
-      if (std::find(used_.begin(), used_.end(), key) == used_.end())
-        bad(path(key), show(v), "unknown key; allowed: " + quoted(used_));
-    }
-  }
 
  private:
   const toml::table* table_;
   std::string name_;
-  std::vector<std::string> used_;
 };
 
 const toml::table* subTable(const toml::table& root, const std::string& name) {
@@ -175,8 +169,7 @@ json parseParameters(const toml::table& root, const toml::table& base, const std
     if (key == "sample.seed") bad(where, key, "seeds are set by [evaluation] seeds, not calibrated");
     if (!seen.insert(key).second) bad(where, key, "each parameter once");
     // Messages name the parameter by its key from here on.
-    Table p(tables[i], fmt::format("parameter \"{}\"", key));
-    p.raw("key");
+    Table p(tables[i], fmt::format("parameter \"{}\"", key), {"key", "min", "max", "start", "log"});
     const auto lo = p.number("min", -1e300, 1e300, false, "a finite number");
     const auto hi = p.number("max", -1e300, 1e300, false, "a finite number");
     if (!lo) bad(p.path("min"), "(missing)", "the lower bound is required");
@@ -187,7 +180,6 @@ json parseParameters(const toml::table& root, const toml::table& base, const std
     const double start = p.number("start", *lo, *hi, false, fmt::format("within [min, max] = [{}, {}]",
                                                                         formatValue(*lo), formatValue(*hi)))
                              .value_or(log ? std::sqrt(*lo * *hi) : 0.5 * (*lo + *hi));
-    p.finish();
     checkParameterValue(base, baseDir, key, "min", *lo);
     checkParameterValue(base, baseDir, key, "max", *hi);
     checkParameterValue(base, baseDir, key, "start", start);
@@ -201,7 +193,7 @@ json parseTargets(const toml::table& root) {
   std::set<std::string> seen;
   const auto tables = tableArray(root, "target");
   for (std::size_t i = 0; i < tables.size(); ++i) {
-    Table t(tables[i], fmt::format("target[{}]", i + 1));
+    Table t(tables[i], fmt::format("target[{}]", i + 1), {"key", "value", "weight", "scale"});
     const auto key = t.string("key");
     if (!key || key->empty() || key->find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.") !=
                                     std::string::npos)
@@ -212,7 +204,6 @@ json parseTargets(const toml::table& root) {
     const double weight = t.number("weight", 0.0, 1e12, true, "must be > 0").value_or(1.0);
     const auto scale = t.number("scale", 0.0, 1e300, true, "must be > 0 (the residual's unit)");
     if (!scale && *value == 0.0) bad(t.path("scale"), "(missing)", "required when value = 0 (default scale: |value|)");
-    t.finish();
     out.push_back({{"key", *key}, {"value", *value}, {"weight", weight}, {"scale", scale.value_or(std::abs(*value))}});
   }
   return out;
@@ -247,11 +238,11 @@ std::map<std::string, std::vector<double>> readCurveCsv(const fs::path& file, co
     if (header.empty()) {
       header = cells;
       if (std::find(header.begin(), header.end(), "eps1") == header.end())
-        bad(where, file.string() + ": header " + line, "needs a column eps1 and any of " + quoted(kCurveQuantities));
+        bad(fmt::format("{} ({}) header", where, file.string()), line, "needs a column eps1 and any of " + quoted(kCurveQuantities));
       continue;
     }
     if (cells.size() != header.size())
-      bad(where, fmt::format("{} line {}: {}", file.string(), lineNo, line),
+      bad(fmt::format("{} ({}) line {}", where, file.string(), lineNo), line,
           fmt::format("{} cells, the header has {}", cells.size(), header.size()));
     for (std::size_t c = 0; c < header.size(); ++c) {
       if (header[c] != "eps1" && std::find(kCurveQuantities.begin(), kCurveQuantities.end(), header[c]) == kCurveQuantities.end())
@@ -260,7 +251,7 @@ std::map<std::string, std::vector<double>> readCurveCsv(const fs::path& file, co
       errno = 0;
       const double v = std::strtod(cells[c].c_str(), &end);
       if (cells[c].empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
-        bad(where, fmt::format("{} line {} column {}: {}", file.string(), lineNo, header[c], cells[c]),
+        bad(fmt::format("{} ({}) line {} column {}", where, file.string(), lineNo, header[c]), cells[c],
             "must be a finite number");
       columns[header[c]].push_back(v);
     }
@@ -270,7 +261,7 @@ std::map<std::string, std::vector<double>> readCurveCsv(const fs::path& file, co
   if (eps1.size() < 3) bad(where, file.string(), "needs at least 3 data rows");
   for (std::size_t i = 1; i < eps1.size(); ++i)
     if (!(eps1[i] > eps1[i - 1]))
-      bad(where, fmt::format("{}: eps1 row {} = {} after {}", file.string(), i + 1, eps1[i], eps1[i - 1]),
+      bad(fmt::format("{} ({}) eps1 of data row {}", where, file.string(), i + 1), fmt::format("{} after {}", eps1[i], eps1[i - 1]),
           "eps1 must increase strictly (one loading branch; compared on a common eps1 grid)");
   return columns;
 }
@@ -278,7 +269,7 @@ std::map<std::string, std::vector<double>> readCurveCsv(const fs::path& file, co
 json parseCurve(const toml::table& root, const fs::path& targetDir, double finalAxialStrain) {
   const toml::table* table = subTable(root, "curve");
   if (!table) return nullptr;
-  Table t(table, "curve");
+  Table t(table, "curve", {"file", "quantities", "q_unit", "strain_unit", "eps1_min", "eps1_max", "points", "weight", "scale"});
   const auto file = t.string("file");
   if (!file) bad(t.path("file"), "(missing)", "a CSV file (relative to the target file)");
   const fs::path path = fs::absolute(fs::path(*file).is_absolute() ? fs::path(*file) : targetDir / *file);
@@ -343,7 +334,6 @@ json parseCurve(const toml::table& root, const fs::path& targetDir, double final
   const double hi = t.number("eps1_max", 0.0, 1.0 / strainFactor, true, strainRange)
                         .value_or(std::min(eps1.back(), finalAxialStrain) / strainFactor) * strainFactor;
   const long points = t.integer("points", 2, 10000).value_or(50);
-  t.finish();
   if (lo < eps1.front() || hi > eps1.back() || !(hi > lo))
     bad("curve.eps1_min/eps1_max", fmt::format("[{}, {}]", lo, hi),
         fmt::format("the grid must lie within the file's eps1 range [{}, {}]", eps1.front(), eps1.back()));
@@ -369,7 +359,7 @@ json parseCurve(const toml::table& root, const fs::path& targetDir, double final
 }
 
 json parseSeeds(const toml::table& root, long configSeed) {
-  Table t(subTable(root, "evaluation"), "evaluation");
+  Table t(subTable(root, "evaluation"), "evaluation", {"seeds"});
   json seeds = json::array();
   const toml::node* n = t.raw("seeds");
   if (!n) {
@@ -388,12 +378,12 @@ json parseSeeds(const toml::table& root, long configSeed) {
   } else {
     bad(t.path("seeds"), show(*n), "an array of 1-1000 distinct integers >= 0 (e.g. [1, 2, 3]) or a count");
   }
-  t.finish();
   return seeds;
 }
 
 json parseOptimizer(const toml::table& root) {
-  Table t(subTable(root, "optimizer"), "optimizer");
+  Table t(subTable(root, "optimizer"), "optimizer",
+          {"algorithm", "max_evaluations", "initial_step", "xtol", "stop_objective", "seed"});
   json o;
   o["algorithm"] = t.string("algorithm", kAlgorithms).value_or("bobyqa");
   o["max_evaluations"] = t.integer("max_evaluations", 1, 100000).value_or(40);
@@ -402,16 +392,14 @@ json parseOptimizer(const toml::table& root) {
   const auto stop = t.number("stop_objective", 0.0, 1e300, false, "must be >= 0");
   o["stop_objective"] = stop ? json(*stop) : json(nullptr);
   o["seed"] = t.integer("seed", 0, std::numeric_limits<int>::max()).value_or(1);
-  t.finish();
   return o;
 }
 
 json parseSensitivity(const toml::table& root) {
-  Table t(subTable(root, "sensitivity"), "sensitivity");
+  Table t(subTable(root, "sensitivity"), "sensitivity", {"enabled", "step"});
   json s;
   s["enabled"] = t.boolean("enabled").value_or(true);
   s["step"] = t.number("step", 0.0, 0.5, true, "in (0, 0.5]: a fraction of each parameter's range").value_or(0.05);
-  t.finish();
   return s;
 }
 
@@ -422,13 +410,12 @@ struct Execution {
 };
 
 Execution parseExecution(const toml::table& root) {
-  Table t(subTable(root, "execution"), "execution");
+  Table t(subTable(root, "execution"), "execution", {"jobs", "threads", "scheduler"});
   Execution e;
   e.jobs = static_cast<int>(t.integer("jobs", 1, 4096).value_or(0));
   e.threads = static_cast<int>(t.integer("threads", 1, 4096).value_or(0));
   e.scheduler = t.string("scheduler").value_or("");
   if (!e.scheduler.empty()) checkSchedulerAddress(e.scheduler, t.path("scheduler"));
-  t.finish();
   return e;
 }
 

@@ -24,8 +24,8 @@ struct DaskCaseResult {
   std::string workers;  // the workers of its attempts, in order ("a then b")
 };
 
-// Runs the cases on the cluster of opt.scheduler (threads per case: `threads`, or 0 for the worker
-// host's cores over its task slots); their folders end up in `out` as the local sweep's do. Blocks
+// Runs the cases on the cluster of opt.scheduler (threads per case: `threads`, or 0 for one thread:
+// each of a worker's task slots is one core); their folders end up in `out` as the local sweep's do. Blocks
 // until every case is done. Throws std::runtime_error when the cluster cannot be used.
 std::vector<DaskCaseResult> runCasesOnDask(const SweepOptions& opt, const std::string& executable,
                                            const std::filesystem::path& out, const std::vector<DaskCase>& cases,
