@@ -5,6 +5,8 @@ set -euo pipefail
 PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev
       python3 python3-numpy python3-matplotlib python3-pytest python3-meshio)
+# grainlab calibrate (NLopt optimisers) and --scheduler (Dask distributed).
+PKGS+=(python3-nlopt python3-distributed)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
