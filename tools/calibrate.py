@@ -19,15 +19,12 @@ Usage (by grainlab): calibrate.py --folder DIR --grainlab EXE --jobs N [--thread
                                   [--scheduler tcp://HOST:PORT] [--quiet]"""
 import argparse
 import json
-import math
 import os
 import shutil
-import subprocess
 import sys
 import time
 
 import nlopt
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import calibrate_report  # noqa: E402
@@ -138,22 +135,25 @@ class Evaluator:
     def evaluate(self, points, kind):
         """points: [(name, u)]. Runs what is missing, all at once, and returns their evaluations."""
         missing = []
+        stored = {}
         for name, u in points:
             param_sets = self.space.sets(u)
+            stored[name] = 0
             for seed in self.seeds:
                 run = f"{name}_seed{seed}"
                 if self.store.lookup(run, param_sets, seed) is None:
                     out = os.path.join(self.store.dir, run)
                     missing.append(dict(self.job_base, name=run, out=out, seed=seed, param_sets=param_sets,
                                         sets=param_sets + [f"sample.seed={seed}"] + RUN_OUTPUT_SETS))
+                else:
+                    stored[name] += 1
         if missing:
             for job in missing:  # a folder left by an interrupted run is never mixed with a new one
                 if os.path.exists(job["out"]):
                     shutil.rmtree(job["out"])
             self.runs_started += len(missing)
             self.runner.run(missing, self.store.record)
-        return [self._assemble(name, u, kind, cached=len(self.seeds) - sum(j["name"].startswith(name + "_") for j in missing))
-                for name, u in points]
+        return [self._assemble(name, u, kind, stored[name]) for name, u in points]
 
     def _assemble(self, name, u, kind, cached):
         records = [self.store.records[f"{name}_seed{seed}"] for seed in self.seeds]
@@ -175,10 +175,8 @@ class Evaluator:
                 evaluation["curves"][q] = {"mean": mean.tolist(), "std": None if std is None else std.tolist()}
             mean_values = {k: v["mean"] for k, v in evaluation["values"].items()}
             mean_curves = {q: c["mean"] for q, c in evaluation["curves"].items()}
-            residual = self.problem.residuals(mean_values, mean_curves)
-            evaluation["objective"] = float(residual @ residual)
-            evaluation["objective_per_seed"] = [
-                float(np.sum(self.problem.residuals(r["values"], r["curves"]) ** 2)) for r in records]
+            evaluation["objective"] = self.problem.objective(mean_values, mean_curves)
+            evaluation["objective_per_seed"] = [self.problem.objective(r["values"], r["curves"]) for r in records]
         else:
             finite = [e["objective"] for e in self.history if e["failed"] is None]
             evaluation["objective"] = FAILURE_PENALTY * max([1.0] + finite)

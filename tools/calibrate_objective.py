@@ -139,6 +139,12 @@ class Problem:
             r += list(factor * (np.asarray(curves[q["name"]]) - self.lab[q["name"]]))
         return np.asarray(r, dtype=float)
 
+    def objective(self, values, curves):
+        """F = r.r, summed exactly rounded (math.fsum): the value, and so the optimiser's path that a
+        resumed calibration replays, must not depend on the BLAS library or the CPU's vector width
+        (a dot product through OpenBLAS differs from the reference BLAS in the last bits)."""
+        return math.fsum(x * x for x in self.residuals(values, curves).tolist())
+
     def output_scales(self):
         """Per residual entry: d r / d output (the weight over the scale)."""
         c = [math.sqrt(t["weight"]) / t["scale"] for t in self.targets]
@@ -169,8 +175,12 @@ def simulated_quantity(series, name):
 
 
 def seed_statistics(per_seed):
-    """Mean and sample standard deviation (None with one seed) over seeds of equal-shape arrays."""
+    """Mean and sample standard deviation (None with one seed) over seeds of equal-length outputs,
+    summed exactly rounded (math.fsum) for the same reason as the objective."""
     a = np.asarray(per_seed, dtype=float)
-    mean = a.mean(axis=0)
-    std = a.std(axis=0, ddof=1) if len(a) > 1 else None
-    return mean, std
+    columns = a.reshape(len(a), -1).T.tolist()
+    n = len(a)
+    mean = [math.fsum(c) / n for c in columns]
+    std = [math.sqrt(math.fsum((x - m) ** 2 for x in c) / (n - 1)) for c, m in zip(columns, mean)] if n > 1 else None
+    shape = a.shape[1:]
+    return np.reshape(mean, shape), None if std is None else np.reshape(std, shape)

@@ -10,7 +10,6 @@ import time
 import tomllib
 
 import numpy as np
-import pytest
 
 from conftest import GRAINLAB
 
