@@ -51,7 +51,7 @@ def test_recovers_friction_and_rolling_resistance_within_the_seed_scatter(grainl
     # friction makes grains roll rather than slide, a higher moment limit stops them rolling
     # (measured on this set-up over 4 seeds: rotation_mean_deg 4.3 -> 5.0 for mu 25 -> 35 deg,
     # 5.2 -> 4.0 for eta 0.08 -> 0.13). With rotations among the targets both are identifiable.
-    truth = {"contact.friction_deg": 25.0, "contact.eta": 0.08}
+    truth = {"contact.friction_deg": 22.0, "contact.eta": 0.08}
     runs = truth_runs(grainlab, tmp_path, [f"{k}={v}" for k, v in truth.items()])
     phi = float(np.mean([s["phi_peak_deg"] for s, _ in runs]))
     rotation = float(np.mean([s["rotation_mean_deg"] for s, _ in runs]))
@@ -59,8 +59,8 @@ def test_recovers_friction_and_rolling_resistance_within_the_seed_scatter(grainl
     (tmp_path / "target.toml").write_text(f"""
 [[parameter]]
 key = "contact.friction_deg"
-min = 20.0
-max = 40.0
+min = 15.0
+max = 45.0
 [[parameter]]
 key = "contact.eta"
 min = 0.05
@@ -97,11 +97,14 @@ max_evaluations = 10
     assert sens["rotation_mean_deg"]["contact.friction_deg"]["range_effect"] > 0.05
     assert sens["rotation_mean_deg"]["contact.eta"]["range_effect"] < -0.2
     assert not any("trade off" in s for s in analysis["statements"])
+    # A DEM sample is chaotic in its parameters as in its seed (a last-bit change of a parameter
+    # reshuffles the force chains), so the optimiser's path is not stable against round-off: the
+    # test asks for what holds whatever the path -- the truth within twice the seed scatter the
+    # calibration reports, and much nearer than the start (the middle of the bounds).
+    start = result["start"]["parameters"]
     for key, value in truth.items():
         assert abs(best[key] - value) <= 2 * scatter[key], (key, best[key], value, scatter[key])
-        # ... and the start (the middle of the bounds) was not already there.
-        p = next(p for p in json.load(open(out / "calibration.json"))["target"]["parameters"] if p["key"] == key)
-        assert abs(p["start"] - value) > 2 * scatter[key]
+        assert abs(best[key] - value) < 0.5 * abs(start[key] - value), (key, best[key], value, start[key])
     assert result["best"]["objective"] < 0.2 * result["start"]["objective"]
     # The calibrated config is ready to use and carries the values.
     grainlab("check", str(out / "best.toml"), check=0)
