@@ -284,6 +284,9 @@ def main():
     except CalibrationError as e:
         print(f"grainlab: calibrate: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print(f"grainlab: calibrate: interrupted; the same command resumes from {folder}", file=sys.stderr)
+        return 130
     finally:
         runner.close()
     if not args.quiet:

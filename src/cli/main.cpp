@@ -42,8 +42,10 @@ int main(int argc, char** argv) {
   sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)");
   sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)");
   sweepCmd->add_flag("--quiet", sweep.quiet, "no progress output");
-  sweepCmd->add_option("--scheduler", sweep.scheduler, "run the cases on this Dask scheduler (tcp://HOST:PORT)");
-  sweepCmd->add_flag("--shared-out", sweep.sharedOut, "with --scheduler: every worker sees --out at the same path");
+  auto* schedulerOpt =
+      sweepCmd->add_option("--scheduler", sweep.scheduler, "run the cases on this Dask scheduler (tcp://HOST:PORT)");
+  sweepCmd->add_flag("--shared-out", sweep.sharedOut, "with --scheduler: every worker sees --out at the same path")
+      ->needs(schedulerOpt);
 
   cli::CalibrateOptions calibrate;
   auto* calibrateCmd = app.add_subcommand("calibrate", "Fit micro-parameters to laboratory values and curves");

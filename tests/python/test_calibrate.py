@@ -248,3 +248,41 @@ def test_target_key_missing_from_the_summary_is_exit_2(grainlab, tmp_path):
     proc = grainlab("calibrate", config, "--target", str(tmp_path / "target.toml"), "--out", str(tmp_path / "o"),
                     "--quiet", check=2)
     assert "phi_peak" in proc.stderr and "phi_peak_deg" in proc.stderr and "not a numeric key" in proc.stderr
+
+
+def test_failed_runs_are_penalised_and_reported(grainlab, tmp_path):
+    # A time step far above the critical one blows the run up (exit 1): that evaluation is marked
+    # failed with the reason and gets the penalty; the calibration goes on with the others.
+    config = small_config(tmp_path, 60, 0.003)
+    text = open(config).read().replace("[solver]\n", "[solver]\nforce_dt = true\ndt = 1.0e-7\n")
+    open(config, "w").write(text)
+    (tmp_path / "target.toml").write_text("""
+[[parameter]]
+key = "solver.dt"
+min = 1.0e-7
+max = 4.0e-6
+start = 4.0e-6
+[[target]]
+key = "phi_peak_deg"
+value = 30.0
+[evaluation]
+seeds = [1]
+[optimizer]
+algorithm = "direct"
+max_evaluations = 3
+[sensitivity]
+enabled = false
+""")
+    out = tmp_path / "cal"
+    grainlab("calibrate", config, "--target", str(tmp_path / "target.toml"), "--out", str(out), "--quiet", check=0)
+    evaluations = [json.loads(line) for line in (out / "evaluations.jsonl").read_text().splitlines()]
+    failed = [e for e in evaluations if e["failed"]]
+    measured = [e for e in evaluations if not e["failed"]]
+    assert failed and measured
+    for e in failed:
+        assert e["failed"].startswith("run failed (exit 1)")
+        assert e["objective"] == 10.0 * max([1.0] + [m["objective"] for m in measured if m["index"] < e["index"]])
+    with open(out / "result.json") as f:
+        best = json.load(f)["best"]
+    assert best["objective"] == min(m["objective"] for m in measured)
+    assert best["parameters"]["solver.dt"] < 4.0e-6
