@@ -8,6 +8,8 @@ PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli1
       libboost-dev)  # libboost-dev: header-only Boost.Math (Gauss–Legendre rules, micromechanics)
 # Checksums of checkpoints and packing files (xxHash), for the program and the Python readers.
 PKGS+=(libxxhash-dev python3-xxhash)
+# grainlab calibrate (NLopt optimisers) and --scheduler (Dask distributed).
+PKGS+=(python3-nlopt python3-distributed)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

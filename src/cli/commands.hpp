@@ -42,9 +42,23 @@ struct SweepOptions {
   int jobs = 2;
   int threads = 0;  // per case; 0: from the config
   bool quiet = false;
+  std::string scheduler;   // tcp://HOST:PORT: cases run on that Dask cluster (sweep_dask.hpp)
+  bool sharedOut = false;  // with scheduler: workers write into the folder directly (a shared path)
 };
 // `grainlab sweep`: exit 0 when every case completed, 1 when any failed.
 int runSweep(const SweepOptions& options);
+
+struct CalibrateOptions {
+  std::string config;
+  std::string target;     // TARGET.toml (docs/calibration.md)
+  std::string outDir;     // the calibration folder (default runs/calibration)
+  std::string scheduler;  // tcp://HOST:PORT: runs on that Dask cluster
+  int jobs = 0;           // runs at once (0: the target's [execution] jobs, else the cores)
+  bool quiet = false;
+};
+// `grainlab calibrate`: validates, then becomes the Python driver (tools/calibrate.py) whose exit
+// code is the command's.
+int runCalibrate(const CalibrateOptions& options);
 
 struct BenchOptions {
   std::string scene = "triaxial-iso";

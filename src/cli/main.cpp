@@ -54,6 +54,20 @@ int main(int argc, char** argv) {
   sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)");
   sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)");
   sweepCmd->add_flag("--quiet", sweep.quiet, "no progress output");
+  auto* schedulerOpt =
+      sweepCmd->add_option("--scheduler", sweep.scheduler, "run the cases on this Dask scheduler (tcp://HOST:PORT)");
+  sweepCmd->add_flag("--shared-out", sweep.sharedOut, "with --scheduler: every worker sees --out at the same path")
+      ->needs(schedulerOpt);
+
+  cli::CalibrateOptions calibrate;
+  auto* calibrateCmd = app.add_subcommand("calibrate", "Fit micro-parameters to laboratory values and curves");
+  calibrateCmd->add_option("config", calibrate.config, "CONFIG.toml or preset:NAME")->required();
+  calibrateCmd->add_option("--target", calibrate.target, "TARGET.toml: parameters, targets, optimiser")->required();
+  calibrateCmd->add_option("--jobs", calibrate.jobs, "runs at once (default: [execution] jobs, else the cores)")
+      ->check(CLI::PositiveNumber);
+  calibrateCmd->add_option("--scheduler", calibrate.scheduler, "run on this Dask scheduler (tcp://HOST:PORT)");
+  calibrateCmd->add_option("--out", calibrate.outDir, "calibration folder (default runs/calibration); rerun to resume");
+  calibrateCmd->add_flag("--quiet", calibrate.quiet, "no progress output");
 
   cli::RunOptions check;
   auto* checkCmd = app.add_subcommand("check", "Validate a config and print it with every default filled in");
@@ -93,6 +107,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("bench")) return cli::runBench(bench);
     if (app.got_subcommand("analyse")) return cli::runAnalyse(analyse);
     if (app.got_subcommand("sweep")) return cli::runSweep(sweep);
+    if (app.got_subcommand("calibrate")) return cli::runCalibrate(calibrate);
     if (app.got_subcommand("check")) return cli::checkConfig(check);
     if (app.got_subcommand("resume")) return cli::resumeLab(resume);
     return cli::runLab(run);

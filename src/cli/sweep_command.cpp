@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/sweep_dask.hpp"
 #include "core/errors.hpp"
 #include "io/config.hpp"
 #include "io/input_file.hpp"
@@ -87,6 +88,7 @@ std::string csvField(const std::string& s) {
 int runSweep(const SweepOptions& opt) {
   if (opt.vary.empty()) throw InputError("sweep: give at least one --vary KEY=V1,V2,...");
   if (opt.jobs < 1) throw InputError(fmt::format("--jobs = {}: must be >= 1", opt.jobs));
+  if (!opt.scheduler.empty()) checkSchedulerAddress(opt.scheduler, "--scheduler");
   std::vector<Vary> varies;
   for (const auto& spec : opt.vary) varies.push_back(parseVary(spec));
 
@@ -143,6 +145,21 @@ int runSweep(const SweepOptions& opt) {
       std::fprintf(stderr, "[%zu/%zu] %s: %s\n", done, cases.size(), jobs[i].name.c_str(),
                    jobs[i].status == 0 ? "completed" : fmt::format("failed (exit {})", jobs[i].status).c_str());
   };
+  // With --scheduler the cases run on a Dask cluster instead (sweep_dask.hpp); the table is the same
+  // with two more columns: how many attempts each case took (> 1: its worker was lost) and where.
+  std::vector<DaskCaseResult> dask;
+  if (!opt.scheduler.empty()) {
+    std::vector<DaskCase> daskCases;
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      jobs[i].name = caseName(i, cases[i]);
+      DaskCase c{jobs[i].name, opt.overrides};
+      for (const auto& [k, v] : cases[i]) c.sets.push_back(k + "=" + v);
+      daskCases.push_back(std::move(c));
+    }
+    dask = runCasesOnDask(opt, self, out, daskCases, opt.threads);
+    for (std::size_t i = 0; i < cases.size(); ++i) jobs[i].status = dask[i].exitCode;
+    done = cases.size();
+  }
   while (done < cases.size()) {
     while (next < cases.size() && running.size() < static_cast<std::size_t>(opt.jobs)) {
       jobs[next].name = caseName(next, cases[next]);
@@ -164,6 +181,7 @@ int runSweep(const SweepOptions& opt) {
   std::string csv = "case,status";
   for (const auto& v : varies) csv += "," + csvField(v.key);
   for (const auto& c : columns) csv += "," + c;
+  if (!dask.empty()) csv += ",attempts,workers";
   csv += "\n";
   int failed = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -185,6 +203,7 @@ int runSweep(const SweepOptions& opt) {
       if (jobs[i].status == 0 && summary.contains(c) && summary[c].is_number())
         csv += fmt::format("{:.8g}", summary[c].get<double>());
     }
+    if (!dask.empty()) csv += fmt::format(",{},{}", dask[i].attempts, csvField(dask[i].workers));
     csv += "\n";
   }
   io::writeFileAtomic(out / "sweep.csv", csv);
