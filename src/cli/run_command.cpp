@@ -18,6 +18,7 @@
 #include "io/config.hpp"
 #include "io/input_file.hpp"
 #include "io/install_paths.hpp"
+#include "io/micro_snapshot.hpp"
 #include "io/packing.hpp"
 #include "io/process.hpp"
 #include "io/results.hpp"
@@ -25,6 +26,7 @@
 #include "io/vtk.hpp"
 #include "lab/grading.hpp"
 #include "lab/macro.hpp"
+#include "lab/micro_network.hpp"
 #include "lab/protocols.hpp"
 #include "lab/sphericity.hpp"
 
@@ -122,15 +124,16 @@ class RunSession {
  public:
   // Writes into folder.work(); messages name folder.target(), where the results end up.
   RunSession(const lab::RunConfig& config, const io::RunFolder& folder, bool quiet, json summary,
-             double secondsBefore, std::vector<double> vtkLabels = {})
+             double secondsBefore, std::vector<double> vtkLabels = {},
+             std::vector<io::MicroSnapshotInfo> microSnapshots = {})
       : config_(config), dir_(folder.work()), target_(folder.target()), quiet_(quiet), progress_(quiet),
         summary_(std::move(summary)), secondsBefore_(secondsBefore), t0_(std::chrono::steady_clock::now()),
-        vtk_(dir_ / "vtk", std::move(vtkLabels)),
+        vtk_(dir_ / "vtk", std::move(vtkLabels)), micro_(dir_ / "micro", std::move(microSnapshots)),
         lab_(config, [this](const std::string& phase, double f, long steps) { progress_.update(phase, f, steps); }) {
+    // The micromechanics snapshots (contact network, for `grainlab analyse` and the rose diagrams)
+    // are taken at the VTK snapshots' instants: the start, every vtk_every_strain and the end.
     if (config.output.vtkEveryStrain > 0.0)
-      lab_.onSnapshot(
-          [this](const Simulation& s, double eps1) { vtk_.write(s, eps1, grainFields()); },
-          config.output.vtkEveryStrain);
+      lab_.onSnapshot([this](const Simulation& s, double eps1) { snapshot(s, eps1); }, config.output.vtkEveryStrain);
     if (config.output.checkpointEvery > 0.0)
       lab_.onCheckpoint([this](const lab::Laboratory&) { writeCheckpoint(); }, config.output.checkpointEvery);
   }
@@ -149,6 +152,10 @@ class RunSession {
              {"in_band", k.inBand}},
             {{"displacement", k.displacement}}};
   }
+  void snapshot(const Simulation& s, double eps1) {
+    vtk_.write(s, eps1, grainFields());
+    if (config_.output.microSnapshots) micro_.write(lab::microNetwork(s), s.stepCount, eps1);
+  }
   json& summary() { return summary_; }
   ProgressLine& progress() { return progress_; }
   io::VtkSeries& vtk() { return vtk_; }
@@ -159,7 +166,10 @@ class RunSession {
   // checkpoint/state.bin: the run so far (summary, VTK snapshot labels, wall time) and the exact
   // binary state, in the checked container of io/checkpoint_file.hpp, renamed into place.
   void writeCheckpoint() {
-    const json record{{"summary", summary_}, {"vtk_labels", vtk_.labels()}, {"wall_seconds", seconds()}};
+    const json record{{"summary", summary_},
+                      {"vtk_labels", vtk_.labels()},
+                      {"micro_snapshots", io::microSnapshotsJson(micro_.snapshots())},
+                      {"wall_seconds", seconds()}};
     std::ostringstream state(std::ios::binary);
     lab_.saveState(state);
     io::writeFileAtomic(dir_ / "checkpoint" / "state.bin", io::encodeCheckpoint(config_, record, state.str()));
@@ -219,6 +229,17 @@ class RunSession {
                    100.0 * shear.maxLateralDeviation);
     summary_["final_axial_strain"] = records.back().eps1;
     summary_["shear_steps"] = shear.steps;
+    // Micromechanics at the peak (the record nearest the peak's strain) and at the end; the largest
+    // energy balance residual over the test (null when no record measured one).
+    std::size_t peak = 0;
+    for (std::size_t i = 0; i < records.size(); ++i)
+      if (std::abs(curves.eps1[i] - m.eps1AtPeak) < std::abs(curves.eps1[peak] - m.eps1AtPeak)) peak = i;
+    summary_["micro_at_peak"] = microJson(records[peak]);
+    summary_["micro_at_end"] = microJson(records.back());
+    std::optional<double> residualMax;
+    for (const auto& r : records)
+      if (std::isfinite(r.energyResidual)) residualMax = std::max(residualMax.value_or(0.0), std::abs(r.energyResidual));
+    summary_["energy_residual_max"] = residualMax ? json(*residualMax) : json(nullptr);
     // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
     const lab::GrainKinematics k = lab_.currentKinematics();
     summary_["rotation_mean_deg"] = k.rotationMeanDeg;
@@ -238,7 +259,7 @@ class RunSession {
 
   int finishIsotropic() {
     const Simulation& sim = lab_.simulation();
-    if (config_.output.vtkEveryStrain > 0.0) vtk_.write(sim, 0.0, grainFields());
+    if (config_.output.vtkEveryStrain > 0.0) snapshot(sim, 0.0);
     const std::vector<lab::Record> records{lab_.measure()};
     return writeResults(records, summary_.value("preparation_steps", 0L));
   }
@@ -266,6 +287,7 @@ class RunSession {
     io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, columns));
     io::writeFileAtomic(dir_ / "summary.json", jsonText(summary_));
     if (config_.output.plots) makePlots(dir_, quiet_);
+    if (!micro_.snapshots().empty()) analyseMicro();
     if (!quiet_) {
       if (summary_.contains("G_MPa"))
         std::printf("phi_peak = %.2f deg at gamma = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, G = %.1f MPa\n",
@@ -283,6 +305,32 @@ class RunSession {
     return 0;
   }
 
+  // The micromechanics columns of one record by name, null where not measurable.
+  json microJson(const lab::Record& r) const {
+    json out = json::object();
+    const std::vector<std::string> names = lab_.microColumnNames();
+    for (std::size_t k = 0; k < names.size(); ++k)
+      out[names[k]] = std::isfinite(r.micro.at(k)) ? json(r.micro[k]) : json(nullptr);
+    out["energy_residual"] = std::isfinite(r.energyResidual) ? json(r.energyResidual) : json(nullptr);
+    out["eps1"] = r.eps1;
+    return out;
+  }
+
+  // The analysis of the run's snapshots (micro/analysis.*, class averages, rose diagrams) as
+  // `grainlab analyse DIR` makes it; a failure there leaves the run's results complete.
+  void analyseMicro() {
+    AnalyseOptions a;
+    a.dir = dir_.string();
+    a.plots = config_.output.plots;
+    a.quiet = true;
+    try {
+      runAnalyse(a);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "grainlab: warning: micromechanics analysis failed (%s); the results are complete without it\n",
+                   e.what());
+    }
+  }
+
   const lab::RunConfig& config_;
   fs::path dir_, target_;
   bool quiet_;
@@ -291,6 +339,7 @@ class RunSession {
   double secondsBefore_;
   std::chrono::steady_clock::time_point t0_;
   io::VtkSeries vtk_;
+  io::MicroSnapshotSeries micro_;
   lab::Laboratory lab_;
 };
 
@@ -423,8 +472,12 @@ int resumeLab(const ResumeOptions& opt) {
   io::checkCheckpointBelongs(checkpoint, stateFile, config, opt.allowOlderVersion);
   omp_set_num_threads(config.solver.threads);
   const json& record = checkpoint.record;
+  // Checkpoints of runs before the micromechanics snapshots have no list: the run numbers from 0.
   RunSession session(config, folder, opt.quiet, record["summary"], record["wall_seconds"].get<double>(),
-                     record["vtk_labels"].get<std::vector<double>>());
+                     record["vtk_labels"].get<std::vector<double>>(),
+                     record.contains("micro_snapshots")
+                         ? io::microSnapshotsFromJson(record["micro_snapshots"], fmt::format("resume {}", io::quotedPath(opt.dir)))
+                         : std::vector<io::MicroSnapshotInfo>{});
   try {
     stateio::MemoryInput in(checkpoint.state);
     session.lab().loadState(in);

@@ -581,6 +581,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                       "must be in [0, 1] (axial strain between checkpoints; 0: none)");
   c.output.vtkEveryStrain = o.number("vtk_every_strain", c.output.vtkEveryStrain, 0.0, 1.0, false, false,
                                      "must be in [0, 1] (0: no VTK snapshots)");
+  c.output.microSnapshots = o.boolean("micro_snapshots", c.output.microSnapshots);
   c.output.bandFactor = o.number("band_factor", c.output.bandFactor, 1.0, 100.0, true, false,
                                  "must be in (1, 100] (a grain is in the shear band when its local shear strain "
                                  "is at least this times the box's)");
@@ -668,6 +669,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                      {"plots", c.output.plots},
                      {"save_packing", c.output.savePacking},
                      {"vtk_every_strain", c.output.vtkEveryStrain},
+                     {"micro_snapshots", c.output.microSnapshots},
                      {"checkpoint_every", c.output.checkpointEvery},
                      {"band_factor", c.output.bandFactor}};
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},

@@ -283,4 +283,52 @@ lab::MicroNetwork readMicroSnapshot(const fs::path& dir, const MicroSnapshotInfo
   return net;
 }
 
+nlohmann::json microSnapshotsJson(const std::vector<MicroSnapshotInfo>& snapshots) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& s : snapshots) {
+    nlohmann::json stress = nullptr;
+    if (s.stress) {
+      stress = nlohmann::json::array();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) stress.push_back((*s.stress)(i, j));
+    }
+    list.push_back({{"index", s.index}, {"step", s.step}, {"eps1", s.eps1}, {"volume", s.volume}, {"stress", stress}});
+  }
+  return list;
+}
+
+std::vector<MicroSnapshotInfo> microSnapshotsFromJson(const nlohmann::json& list, const std::string& where) {
+  auto bad = [&](const std::string& what) {
+    return InputError(fmt::format("{}: micro_snapshots: {}", where, what));
+  };
+  if (!list.is_array()) throw bad("not a list");
+  std::vector<MicroSnapshotInfo> out;
+  for (const auto& e : list) {
+    auto number = [&](const char* key) {
+      if (!e.is_object() || !e.contains(key) || !e[key].is_number() || !std::isfinite(e[key].get<double>()))
+        throw bad(fmt::format("entry {}: \"{}\" missing or not a finite number", out.size(), key));
+      return e[key].get<double>();
+    };
+    MicroSnapshotInfo info;
+    info.index = static_cast<int>(number("index"));
+    info.step = static_cast<long>(number("step"));
+    info.eps1 = number("eps1");
+    info.volume = number("volume");
+    if (info.index != static_cast<int>(out.size())) throw bad(fmt::format("entry {}: index {} out of order", out.size(), info.index));
+    const nlohmann::json& st = e.value("stress", nlohmann::json());
+    if (!st.is_null()) {
+      if (!st.is_array() || st.size() != 9) throw bad(fmt::format("entry {}: stress is not 9 numbers", out.size()));
+      Mat3 m;
+      for (int k = 0; k < 9; ++k) {
+        if (!st[k].is_number() || !std::isfinite(st[k].get<double>()))
+          throw bad(fmt::format("entry {}: stress component {} is not a finite number", out.size(), k));
+        m(k / 3, k % 3) = st[k].get<double>();
+      }
+      info.stress = m;
+    }
+    out.push_back(info);
+  }
+  return out;
+}
+
 }  // namespace grainlab::io

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "lab/micromechanics.hpp"
 
 namespace grainlab::io {
@@ -43,6 +45,11 @@ class MicroSnapshotSeries {
   std::filesystem::path dir_;
   std::vector<MicroSnapshotInfo> snapshots_;
 };
+
+// The list of snapshots as a checkpoint keeps it (so that a resumed run numbers on as an
+// uninterrupted one), and back; the reader throws InputError on anything malformed.
+nlohmann::json microSnapshotsJson(const std::vector<MicroSnapshotInfo>& snapshots);
+std::vector<MicroSnapshotInfo> microSnapshotsFromJson(const nlohmann::json& list, const std::string& where);
 
 std::string microIndexCsv(const std::vector<MicroSnapshotInfo>& snapshots);
 std::string microParticlesCsv(const lab::MicroNetwork& network);

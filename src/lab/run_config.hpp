@@ -115,6 +115,7 @@ struct OutputConfig {
   bool plots = true;
   bool savePacking = true;  // packing.txt of the prepared sample, reusable as sample.packing
   double vtkEveryStrain = 0.01;  // ParaView snapshots during shearing; 0 = none
+  bool microSnapshots = true;    // contact-network snapshots (micro/) with the VTK ones, analysed at the end
   double checkpointEvery = 0.01;  // checkpoints during shearing, in axial strain; 0 = none
   double bandFactor = 2.0;  // a grain is in the shear band when its local eq >= this x the box's
 };

@@ -16,8 +16,11 @@ VOLATILE = {"wall_seconds", "particle_steps_per_s"}
 
 def outputs(out):
     summary = json.loads((out / "summary.json").read_text())
+    # The micromechanics snapshots (network, index) and their analysis too: a resumed run numbers
+    # its snapshots on from the checkpoint, as the uninterrupted run did.
+    micro = {p.name: p.read_bytes() for p in sorted((out / "micro").iterdir())}
     return ({k: v for k, v in summary.items() if k not in VOLATILE}, (out / "timeseries.csv").read_text(),
-            (out / "vtk" / "particles.pvd").read_text())
+            (out / "vtk" / "particles.pvd").read_text(), micro)
 
 
 def test_kill_and_resume_is_bit_identical(grainlab, data_dir, tmp_path):
@@ -50,6 +53,8 @@ def test_kill_and_resume_is_bit_identical(grainlab, data_dir, tmp_path):
     assert a[0] == b[0]
     assert a[1] == b[1]
     assert a[2] == b[2]
+    assert "snapshots.csv" in a[3] and "analysis.json" in a[3] and "contacts_0003.csv" in a[3]
+    assert a[3] == b[3]
     # Resuming a finished run does nothing.
     assert "already completed" in grainlab("resume", str(cut), check=0).stdout
 
