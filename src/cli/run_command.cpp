@@ -430,10 +430,20 @@ int runLab(const RunOptions& opt) {
       s["dt"] = sim.dt;
       s["dt_critical"] = sim.criticalTimeStep();
       s["preparation_steps"] = prep.steps;
+      if (!prep.growth.empty()) {
+        // [O]'s growth curve: Z (and its spread over the particles) and packing fraction per stage.
+        json curve = json::array();
+        for (const auto& g : prep.growth)
+          curve.push_back({{"eccentricity", g.eccentricity}, {"Z", g.coordination}, {"Z_std", g.coordinationStd},
+                           {"packing_fraction", g.packingFraction}});
+        s["growth_curve"] = curve;
+      }
       if (!opt.quiet) {
-        const std::string how = config.sample.packing.empty()
-                                    ? fmt::format("target {:.3f}, mu_prep = {:.2f} deg", config.sample.e0, prep.prepFrictionDeg.value_or(0.0))
-                                    : std::string("from the packing file");
+        const std::string how =
+            !config.sample.packing.empty()            ? std::string("from the packing file")
+            : config.sample.method != "compaction"    ? fmt::format("frictionless {}: no target", config.sample.method)
+                                                      : fmt::format("target {:.3f}, mu_prep = {:.2f} deg", config.sample.e0,
+                                                                    prep.prepFrictionDeg.value_or(0.0));
         std::fprintf(stderr, "prepared: e0 = %.4f (%s), p = %.1f kPa\n", prep.e0, how.c_str(),
                      (prep.state.boundaryStress.sum() / 3.0) / 1e3);
       }

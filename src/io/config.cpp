@@ -461,7 +461,12 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice"});
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
+  c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
+                                    "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
+  if (c.sample.latticeJitter > 0.0 && (c.sample.method != "lattice" || c.sample.shape.type != "ellipsoid"))
+    fail("sample.lattice_jitter", fmt::format("{}", c.sample.latticeJitter),
+         "applies to sample.method = \"lattice\" with sample.shape.type = \"ellipsoid\" only (it perturbs the grown lattice)");
   if (c.sample.method == "lattice") {
     const long n = c.sample.nParticles;
     const long side = std::lround(std::cbrt(static_cast<double>(n)));
@@ -618,6 +623,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
       {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
       {"method", c.sample.method},
       {"growth_rate", c.sample.growthRate},
+      {"lattice_jitter", c.sample.latticeJitter},
       {"shape", toml::table{{"type", c.sample.shape.type},
                             {"elongation", c.sample.shape.elongation},
                             {"flatness", c.sample.shape.flatness},

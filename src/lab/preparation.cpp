@@ -128,6 +128,7 @@ PreparationResult Laboratory::prepare() {
     }
   }
   sim_ = std::move(best);
+  result.growth = growthCurve_;
   records_.reset(sim_);
   result.state = equilibriumState();
   return result;
@@ -155,6 +156,23 @@ long Laboratory::growShapes() {
   }
   std::vector<double> radius0(n);
   for (std::size_t i = 0; i < n; ++i) radius0[i] = P.equivalentRadius[i];
+  // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
+  // from the compressed lattice is not affine. sample.lattice_jitter moves every grain by up to that
+  // fraction of its diameter along each axis before the first stage, small beside the contact
+  // overlaps, so that the Z = 6 start is kept and the symmetry is broken.
+  if (config_.sample.latticeJitter > 0.0)
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) P.position[i][a] += config_.sample.latticeJitter * 2.0 * radius0[i] * rng.uniform(-1.0, 1.0);
+  growthCurve_.clear();
+  auto recordStage = [&](double e) {
+    const std::vector<int> z = contactsPerParticle(sim_);
+    double mean = 0.0, square = 0.0;
+    for (int c : z) mean += c;
+    mean /= static_cast<double>(n);
+    for (int c : z) square += (c - mean) * (c - mean);
+    growthCurve_.push_back({e, mean, std::sqrt(square / static_cast<double>(n)), 1.0 / (1.0 + voidRatio(sim_))});
+  };
+  recordStage(0.0);
   // Eccentricity (a - b)/(a + b) of the final shape, reached in equal steps of at most
   // eccentricity_step; the flatness goes from 1 to its final value in the same steps.
   const double eFinal = (1.0 - shape.elongation) / (1.0 + shape.elongation);
@@ -175,6 +193,7 @@ long Laboratory::growShapes() {
     sim_.initialise(config_.solver.skinFraction);
     sim_.dt = config_.solver.dtFactor * sim_.criticalTimeStep();
     steps += consolidate(pressure, fmt::format("shape growth {}/{} (eccentricity {:.3f})", k, stages, e));
+    recordStage(e);
   }
   sim_.model.tanFriction = friction;
   return steps;

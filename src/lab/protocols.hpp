@@ -69,8 +69,17 @@ struct EquilibriumState {
   double coordination;
 };
 
+// One stage of the [O] growth of grain shape (after its relaxation at constant p).
+struct GrowthStage {
+  double eccentricity = 0.0;     // (a - b)/(a + b) of the grown grains
+  double coordination = 0.0;     // Z, contacts per particle
+  double coordinationStd = 0.0;  // spread of the particles' contact counts (standard deviation)
+  double packingFraction = 0.0;  // solid volume / cell volume
+};
+
 struct PreparationResult {
   double e0 = 0.0;                          // reached
+  std::vector<GrowthStage> growth;          // the shape growth curve (ellipsoids), stage 0 = spheres
   std::optional<double> prepFrictionDeg;    // used for the final sample (none for a packing file)
   std::vector<std::pair<double, double>> search;  // (mu_prep deg, e reached) per trial
   long steps = 0;
@@ -170,6 +179,7 @@ class Laboratory {
   MicroAnalyzer micro_;
   MicroColumnSet microColumns_;
   double d50_ = 0.0;
+  std::vector<GrowthStage> growthCurve_;  // of the last growShapes(); preparation only, not in checkpoints
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();
   long growRadii();

@@ -76,7 +76,7 @@ static_assert(sizeof(Simulation) ==
 static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
-                             lab::MicroColumnSet, double>(),
+                             lab::MicroColumnSet, double, std::vector<lab::GrowthStage>>(),
               "Laboratory changed: update Laboratory::saveState/loadState and this list");
 static_assert(std::is_trivially_copyable_v<Wall> && std::is_trivially_copyable_v<lab::Record> &&
               std::is_trivially_copyable_v<contact::SphereContactModel>);
