@@ -1,0 +1,246 @@
+"""The reference docs (docs/interface.md, docs/laboratory.md, docs/physics.md) against the program, so
+that neither can drift from the other:
+
+- the configuration keys listed in docs/interface.md are exactly the keys src/io/config.cpp reads;
+- every default written there is what `grainlab check` prints, and a key written as unset is not
+  printed;
+- every option of every subcommand's --help is documented in that subcommand's section;
+- the presets table lists exactly what `grainlab presets` lists;
+- the time-series columns and summary keys of docs/laboratory.md are what a short run writes (the
+  columns of the cell, simple-shear and true-triaxial tests from src/io/results.cpp);
+- every link to a heading of these pages resolves.
+"""
+import json
+import os
+import re
+import subprocess
+import tomllib
+
+import pytest
+
+from conftest import DATA, GRAINLAB
+
+ROOT = os.path.join(os.path.dirname(__file__), "..", "..")
+DOCS = os.path.join(ROOT, "docs")
+SECTIONS = ("sample", "contact", "test", "solver", "output")
+
+
+def read(*parts):
+    with open(os.path.join(ROOT, *parts), encoding="utf-8") as f:
+        return f.read()
+
+
+def section(text, heading):
+    """The text under a Markdown heading that starts with `heading`, up to the next heading of the same
+    or a higher level."""
+    lines = text.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("#") and line.lstrip("#").strip().startswith(heading):
+            level = len(line) - len(line.lstrip("#"))
+            body = []
+            for nxt in lines[i + 1:]:
+                if nxt.startswith("#") and len(nxt) - len(nxt.lstrip("#")) <= level:
+                    break
+                body.append(nxt)
+            return "\n".join(body)
+    raise AssertionError(f"no heading {heading!r}")
+
+
+def table_rows(text):
+    """Cells of the Markdown table rows in `text` (header and separator rows included)."""
+    return [[c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line.strip()[1:-1])]
+            for line in text.splitlines() if line.strip().startswith("|")]
+
+
+def documented_keys():
+    """docs/interface.md: config key -> its default cell."""
+    keys = {}
+    for cells in table_rows(section(read("docs", "interface.md"), "Configuration")):
+        m = re.fullmatch(r"`((?:%s)\.[a-z0-9_.]+)`" % "|".join(SECTIONS), cells[0])
+        if m:
+            assert m.group(1) not in keys, f"{m.group(1)} documented twice"
+            assert len(cells) == 5, f"row of {m.group(1)}: expected key | type | default | allowed | meaning"
+            keys[m.group(1)] = cells[2]
+    return keys
+
+
+def source_keys():
+    """Every key src/io/config.cpp reads: section getters, and the keys of the inline tables."""
+    src = read("src", "io", "config.cpp")
+    variables = dict(re.findall(r'Section (\w+)\(root, "(\w+)"\)', src))
+    assert set(variables.values()) == set(SECTIONS), variables
+    keys = {f"{variables[v]}.{k}" for v, k in
+            re.findall(r'\b(\w+)\.(?:number|integer|boolean|string|raw)\("(\w+)"', src) if v in variables}
+
+    def body(start, end):
+        i = src.index(start)
+        return src[i:src.index(end, i)]
+
+    grading = set(re.findall(r'get\("(\w+)"\)', body("lab::GradingConfig parseGrading", "\n}\n")))
+    shape = set(re.findall(r'name != "(\w+)"', body("lab::ShapeConfig parseShape", "\n}\n")))
+    sphericity = set(re.findall(r'name != "(\w+)"', body("if (sph) {", "c.contact.sphericity = sc;")))
+    for name, sub in (("grading", grading), ("shape", shape), ("sphericity", sphericity)):
+        assert sub, f"no keys of {name} found in config.cpp: the test's patterns need updating"
+    keys |= {f"sample.grading.{k}" for k in grading}
+    keys |= {f"sample.shape.{k}" for k in shape}
+    keys |= {f"contact.sphericity.{k}" for k in sphericity}
+    return keys
+
+
+def flatten(table, prefix=""):
+    out = {}
+    for k, v in table.items():
+        if isinstance(v, dict):
+            out.update(flatten(v, prefix + k + "."))
+        else:
+            out[prefix + k] = v
+    return out
+
+
+def test_documented_keys_are_the_parsers_keys():
+    doc, src = set(documented_keys()), source_keys()
+    assert not src - doc, f"accepted by config.cpp but not in docs/interface.md: {sorted(src - doc)}"
+    assert not doc - src, f"in docs/interface.md but not read by config.cpp: {sorted(doc - src)}"
+
+
+def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
+    sphericity = os.path.abspath(os.path.join(ROOT, "presets", "data", "sphericity-synthetic.csv"))
+    configs = {
+        "defaults": "",
+        "rolling": '[contact]\nmodel = "rolling-linear"\n',
+        "sphericity": f'[contact]\nmodel = "rolling-linear"\nsphericity = {{ file = "{sphericity}", k = -4.0 }}\n',
+    }
+    printed = {}
+    for name, text in configs.items():
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        printed[name] = flatten(tomllib.loads(grainlab("check", str(path), check=0).stdout))
+    resolved = {}
+    for name in configs:
+        for k, v in printed[name].items():
+            resolved.setdefault(k, v)
+    problems = []
+    for key, cell in documented_keys().items():
+        if cell == "—":
+            if key in printed["defaults"]:
+                problems.append(f"{key}: documented as unset, check prints {printed['defaults'][key]!r}")
+            continue
+        literal = re.fullmatch(r"`(.+)`", cell)
+        if not literal:
+            continue  # a table of keys whose own rows carry the defaults
+        value = tomllib.loads("v = " + literal.group(1))["v"]
+        if key not in resolved:
+            problems.append(f"{key}: documented default {literal.group(1)}, not printed by check")
+        elif resolved[key] != value:
+            problems.append(f"{key}: documented default {literal.group(1)}, check prints {resolved[key]!r}")
+    documented = documented_keys()
+    for key in printed["defaults"]:
+        if key not in documented:
+            problems.append(f"{key}: printed by check, not documented")
+    assert not problems, "\n".join(problems)
+
+
+SUBCOMMANDS = ("run", "check", "resume", "presets", "sweep", "calibrate", "analyse", "bench")
+
+
+def test_every_option_of_every_command_is_documented(grainlab):
+    doc = section(read("docs", "interface.md"), "Commands")
+    top = grainlab("--help", check=0).stdout
+    listed = set(re.findall(r"^  ([a-z]+) {2,}", top.split("Subcommands:")[1], re.M))
+    assert listed == set(SUBCOMMANDS), f"subcommands in --help: {sorted(listed)}"
+    missing = []
+    for sub in SUBCOMMANDS:
+        text = section(doc, f"`grainlab {sub}")
+        options = set(re.findall(r"(--[a-z][a-z-]*)", grainlab(sub, "--help", check=0).stdout)) - {"--help"}
+        missing += [f"grainlab {sub} {o}" for o in sorted(options) if f"`{o}" not in text]
+    assert not missing, f"options not documented in their command's section: {missing}"
+
+
+def test_presets_table_lists_the_shipped_presets(grainlab):
+    shipped = {line.split()[0] for line in grainlab("presets", check=0).stdout.splitlines() if line.strip()}
+    rows = table_rows(section(read("docs", "interface.md"), "Presets"))
+    documented = {m.group(1) for cells in rows if (m := re.fullmatch(r"`([a-z0-9-]+)`", cells[0]))}
+    assert documented == shipped
+    lab = table_rows(section(read("docs", "laboratory.md"), "5. Reference set-ups and presets"))
+    assert {m.group(1) for cells in lab if (m := re.fullmatch(r"`([a-z0-9-]+)`", cells[0]))} == shipped
+
+
+def names_in(cell):
+    """Backticked names of a table cell, `x_1..3` expanded, comma lists inside one pair of backticks split."""
+    names = []
+    for group in re.findall(r"`([^`]+)`", cell):
+        for name in (n.strip() for n in group.split(",")):
+            m = re.fullmatch(r"(\w+)_1\.\.3", name)
+            names += [f"{m.group(1)}_{k}" for k in (1, 2, 3)] if m else [name]
+    return names
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    """A short triaxial test in a wall box: 300 spheres, 0.3 % axial strain, no plots or snapshots."""
+    out = tmp_path_factory.mktemp("docs") / "run"
+    proc = subprocess.run([GRAINLAB, "run", os.path.join(DATA, "small-triaxial.toml"), "--out", str(out), "--quiet",
+                           "--threads", "1", "--set", "test.final_axial_strain=0.003",
+                           "--set", "output.vtk_every_strain=0", "--set", "output.checkpoint_every=0"],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_timeseries_columns_are_documented_in_order(short_run):
+    header = (short_run / "timeseries.csv").read_text().splitlines()[0].split(",")
+    # The columns of the other tests, where results.cpp inserts them: before energy_residual.
+    src = read("src", "io", "results.cpp")
+    extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
+    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial"}, extra
+    i = header.index("energy_residual")
+    expected = header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")] + header[i:]
+    rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
+    documented = [n for cells in rows[2:] for n in names_in(cells[0])]
+    assert documented == expected
+
+
+SUMMARY_ONLY_SOMETIMES = {
+    "mu_r_mean", "mu_r_min", "mu_r_max",   # rolling-linear runs
+    "G_MPa", "final_shear_strain",         # simple shear
+    "error",                               # failed runs
+}
+
+
+def test_summary_keys_are_documented(short_run):
+    summary = json.loads((short_run / "summary.json").read_text())
+    rows = table_rows(section(read("docs", "laboratory.md"), "3.4 Summary"))
+    documented = {}
+    for cells in rows[2:]:
+        for name in names_in(cells[0]):
+            documented[name] = cells[1]
+    assert not set(summary) - set(documented), f"written but not documented: {sorted(set(summary) - set(documented))}"
+    stale = set(documented) - set(summary) - SUMMARY_ONLY_SOMETIMES
+    assert not stale, f"documented but not written by a triaxial run: {sorted(stale)}"
+    for nested in ("grading", "isotropic_state"):
+        assert set(names_in(documented[nested])) == set(summary[nested]), nested
+
+
+def slug(heading):
+    """GitHub's anchor of a heading."""
+    text = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return text.replace(" ", "-")
+
+
+@pytest.mark.parametrize("page", ["physics.md", "laboratory.md", "interface.md"])
+def test_links_to_headings_resolve(page):
+    text = read("docs", page)
+    broken = []
+    for target, anchor in re.findall(r"\]\(([\w./-]*?)#([\w-]+)\)", text):
+        path = os.path.join(DOCS, target) if target else os.path.join(DOCS, page)
+        if not os.path.exists(path):
+            broken.append(f"{target}#{anchor}: no such file")
+            continue
+        with open(path, encoding="utf-8") as f:
+            anchors = {slug(line.lstrip("#")) for line in f if line.startswith("#")}
+        if anchor not in anchors:
+            broken.append(f"{target or page}#{anchor}")
+    for target in re.findall(r"\]\(([\w./-]+\.md)\)", text):
+        if not os.path.exists(os.path.join(DOCS, target)):
+            broken.append(f"{target}: no such file")
+    assert not broken, broken
