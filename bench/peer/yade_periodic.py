@@ -33,7 +33,7 @@ from yade import O, utils  # noqa: E402
 from yade.wrapper import (Bo1_Sphere_Aabb, ForceResetter, Ig2_Sphere_Sphere_ScGeom6D,  # noqa: E402
                           InsertionSortCollider, InteractionLoop, Ip2_CohFrictMat_CohFrictMat_CohFrictPhys,
                           Law2_ScGeom6D_CohFrictPhys_CohesionMoment, NewtonIntegrator, PeriTriaxController)
-from minieigen import Matrix3, Vector3  # noqa: E402
+from yade.minieigenHP import Matrix3, Vector3  # noqa: E402 (Debian yade 2023: no separate minieigen)
 import packing_file  # noqa: E402
 import yade_scene  # noqa: E402
 

@@ -12,6 +12,7 @@
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "io/config.hpp"
 #include "io/input_file.hpp"
 #include "io/packing.hpp"
 #include "io/results.hpp"
@@ -81,17 +82,26 @@ void buildLattice(int requested, double density, Simulation& sim) {
 }  // namespace
 
 int runBench(const BenchOptions& opt) {
-  if (opt.scene != "triaxial-iso" && opt.scene != "lattice")
+  if (!opt.config.empty() && opt.packing.empty())
+    throw InputError("bench --config: applies with --packing only (the scenes have their own law)");
+  if (opt.packing.empty() && opt.scene != "triaxial-iso" && opt.scene != "lattice")
     throw InputError(fmt::format("bench scene \"{}\" is unknown; available: triaxial-iso, lattice", opt.scene));
   if (opt.particles < 10) throw InputError(fmt::format("--particles = {}: must be >= 10", opt.particles));
   if (opt.steps < 1) throw InputError(fmt::format("--steps = {}: must be >= 1", opt.steps));
   if (opt.threads < 1) throw InputError(fmt::format("--threads = {}: must be >= 1", opt.threads));
-  const lab::RunConfig config = benchConfig(opt.particles);
+  lab::RunConfig config = benchConfig(opt.particles);
+  if (!opt.config.empty()) config = io::parseConfig(io::loadConfigTable(opt.config), io::configBaseDir(opt.config));
   const fs::path cache = cacheFile(opt.scene, opt.particles);
+  const std::string scene = opt.packing.empty() ? opt.scene : "packing";
 
   Simulation sim;
   omp_set_num_threads(std::max(2, opt.threads));  // preparation uses what is there
-  if (opt.scene == "lattice") {
+  if (!opt.packing.empty()) {
+    // Any packing (a run's packing.txt, another program's sample converted): its grains, shapes and
+    // boundary as they are, held at the config's pressure by its walls or cell.
+    io::simulationFromPacking(io::readPackingFile(opt.packing, "bench --packing"), config.sample.density, sim,
+                              fmt::format("bench --packing {}", io::quotedPath(opt.packing)));
+  } else if (opt.scene == "lattice") {
     buildLattice(opt.particles, config.sample.density, sim);
   } else if (fs::exists(cache)) {
     const std::string subject = fmt::format("bench cache {}", io::quotedPath(cache));
@@ -105,12 +115,7 @@ int runBench(const BenchOptions& opt) {
     io::writeFileAtomic(cache, io::packingText(io::packingFromSimulation(sim, "grainlab bench sample " + opt.scene)));
   }
   lab::configureSolver(config, sim);
-  if (opt.scene != "lattice") {
-    for (Wall& w : sim.box.walls) {
-      w.control = WallControl::Stress;
-      w.targetStress = config.test.confiningPressure;
-    }
-  }
+  if (scene != "lattice") lab::holdIsotropicStress(sim, config.test.confiningPressure);
   omp_set_num_threads(opt.threads);
   for (int i = 0; i < 200; ++i) sim.step();  // rebuild contacts and their history
   const long buildsBefore = sim.broadPhase.builds;
@@ -119,7 +124,12 @@ int runBench(const BenchOptions& opt) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double rate = static_cast<double>(opt.steps) * sim.particles.size() / seconds;
   const long peakRss = peakResidentBytes();
-  nlohmann::json j{{"scene", opt.scene},
+  std::size_t ellipsoids = 0;
+  for (Shape s : sim.particles.shape) ellipsoids += s == Shape::Ellipsoid;
+  nlohmann::json j{{"scene", scene},
+                   {"packing", opt.packing.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt.packing)},
+                   {"boundary", sim.boundary == Boundary::Periodic ? "periodic" : "walls"},
+                   {"n_ellipsoids", ellipsoids},
                    {"n_particles", sim.particles.size()},
                    {"n_contacts", sim.touchingPairs()},
                    {"steps", opt.steps},
@@ -135,7 +145,7 @@ int runBench(const BenchOptions& opt) {
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("{}: {} particles, {} contacts, {} steps on {} thread(s): {:.3f} s, {:.3g} particle-steps/s\n",
-               opt.scene, sim.particles.size(), sim.touchingPairs(), opt.steps, opt.threads, seconds, rate);
+               scene, sim.particles.size(), sim.touchingPairs(), opt.steps, opt.threads, seconds, rate);
   }
   return 0;
 }

@@ -66,6 +66,8 @@ struct BenchOptions {
   long steps = 2000;
   int threads = 1;
   bool json = false;
+  std::string packing;  // time this packing instead of a scene
+  std::string config;   // the contact law, damping and pressure for --packing (default: the [W] law)
 };
 int runBench(const BenchOptions& options);
 

@@ -82,6 +82,12 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--steps", bench.steps, "timed steps")->capture_default_str();
   benchCmd->add_option("--threads", bench.threads, "OpenMP threads")->capture_default_str();
   benchCmd->add_flag("--json", bench.json, "print one JSON object");
+  benchCmd->add_option("--packing", bench.packing,
+                       "time this packing file (walls or periodic cell, spheres or ellipsoids) held at the "
+                       "config's confining pressure, instead of a scene");
+  benchCmd->add_option("--config", bench.config,
+                       "with --packing: CONFIG.toml or preset:NAME giving the contact law, damping and pressure "
+                       "(default: the [W] law at 100 kPa)");
 
   cli::AnalyseOptions analyse;
   auto* analyseCmd = app.add_subcommand("analyse", "Micromechanics of a finished run, from its snapshots (DIR/micro)");

@@ -464,9 +464,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
                                     "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
-  if (c.sample.latticeJitter > 0.0 && (c.sample.method != "lattice" || c.sample.shape.type != "ellipsoid"))
-    fail("sample.lattice_jitter", fmt::format("{}", c.sample.latticeJitter),
-         "applies to sample.method = \"lattice\" with sample.shape.type = \"ellipsoid\" only (it perturbs the grown lattice)");
+  if (c.sample.latticeJitter > 0.0 && c.sample.method != "lattice")
+    fail("sample.lattice_jitter", fmt::format("{}", c.sample.latticeJitter), "applies to sample.method = \"lattice\" only");
   if (c.sample.method == "lattice") {
     const long n = c.sample.nParticles;
     const long side = std::lround(std::cbrt(static_cast<double>(n)));

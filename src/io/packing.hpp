@@ -13,15 +13,15 @@
 //                                                  edge vectors, origin 0 [m]
 //   # particles N
 //   # columns id shape a b c x y z qw qx qy qz
-//   # xxh64 <16 hex digits: xxh64 (seed 0) of every byte after this line>
+//   # xxh64 <16 hex digits: xxh64 (seed 0) of every byte of the file except this line>
 //   N rows: id (unsigned integer, unique), shape (sphere|ellipsoid), semi-axes a >= b >= c > 0 [m]
 //   (sphere: a = b = c = radius), centre x y z [m], orientation quaternion qw qx qy qz (unit within
 //   1e-6; identity for spheres, whose orientation is not used)
 //
 // Every header line is required except xxh64: a file written by hand without it is accepted after
 // every other check (grainlab always writes it). The lines after the first may come in any order,
-// but xxh64 must be the last. The checksum covers the rows only, so the free text of `program` and
-// `comment` and the numbers of `walls`/`cell` are checked for form, not for integrity. Version 1 (grainlab 0.1: a
+// but xxh64 must be the last. The checksum covers every byte but its own line (the header with the
+// walls or cell, program and comment, and the rows). Version 1 (grainlab 0.1: a
 // comment line, a line of six wall positions, then `radius x y z` rows) stays readable.
 #include <array>
 #include <cstdint>
@@ -61,10 +61,10 @@ PackingData readPackingFile(const std::filesystem::path& file, const std::string
 // The same for text in memory; `subject` starts every message.
 PackingData parsePacking(std::string_view text, const std::string& subject);
 
-// The spheres and walls of a simulation (ids = particle indices).
+// The grains (persistent ids, shapes, orientations) and the walls or cell of a simulation.
 PackingData packingFromSimulation(const Simulation& sim, const std::string& comment);
-// Replaces the particles and walls of `sim`. This build simulates spheres between walls only: an
-// ellipsoid or a periodic cell is an InputError naming `subject`.
+// Replaces the particles and the boundary (walls or periodic cell) of `sim` with those of the
+// packing; anything the engine cannot take is an InputError naming `subject`.
 void simulationFromPacking(const PackingData& packing, double density, Simulation& sim, const std::string& subject);
 
 }  // namespace grainlab::io

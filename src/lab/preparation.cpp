@@ -27,6 +27,25 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   steps += consolidate(config_.test.confiningPressure,
                        config_.sample.method == "compaction" ? fmt::format("compaction (mu_prep {:.1f} deg)", muDeg)
                                                              : std::string("isotropic compression"));
+  // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
+  // from the compressed lattice is not affine. sample.lattice_jitter moves every grain of the
+  // compressed lattice by up to that fraction of its diameter along each axis (small beside the
+  // contact overlaps, so the Z = 6 start is kept) and breaks the symmetry; spheres then relax at p
+  // without friction, ellipsoids in the first stage of their growth.
+  if (config_.sample.latticeJitter > 0.0) {
+    Rng rng(config_.sample.seed ^ 0x9e3779b97f4a7c15ull);
+    Particles& P = sim_.particles;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      for (int a = 0; a < 3; ++a)
+        P.position[i][a] += config_.sample.latticeJitter * 2.0 * P.equivalentRadius[i] * rng.uniform(-1.0, 1.0);
+    sim_.initialise(config_.solver.skinFraction);
+    if (config_.sample.shape.type != "ellipsoid") {
+      const double friction = sim_.model.tanFriction;
+      sim_.model.tanFriction = 0.0;
+      steps += consolidate(config_.test.confiningPressure, "relaxation of the perturbed lattice");
+      sim_.model.tanFriction = friction;
+    }
+  }
   if (config_.sample.shape.type == "ellipsoid") steps += growShapes();
   steps += rampStiffness();
   configureSolver(config_, sim_);
@@ -156,13 +175,6 @@ long Laboratory::growShapes() {
   }
   std::vector<double> radius0(n);
   for (std::size_t i = 0; i < n; ++i) radius0[i] = P.equivalentRadius[i];
-  // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
-  // from the compressed lattice is not affine. sample.lattice_jitter moves every grain by up to that
-  // fraction of its diameter along each axis before the first stage, small beside the contact
-  // overlaps, so that the Z = 6 start is kept and the symmetry is broken.
-  if (config_.sample.latticeJitter > 0.0)
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < 3; ++a) P.position[i][a] += config_.sample.latticeJitter * 2.0 * radius0[i] * rng.uniform(-1.0, 1.0);
   growthCurve_.clear();
   auto recordStage = [&](double e) {
     const std::vector<int> z = contactsPerParticle(sim_);
@@ -209,6 +221,7 @@ PreparationResult Laboratory::adoptPacking(Simulation packed) {
                                  config_.test.boundary));
   records_ = GrainRecords{};
   records_.sphericity = assignRollingFriction(config_, sim_.particles);
+  for (Shape s : sim_.particles.shape) microColumns_.nonSpherical = microColumns_.nonSpherical || s == Shape::Ellipsoid;
   std::vector<double> diameters(sim_.particles.size());
   for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.radius[i];
   result.grading = gradingStats(diameters);

@@ -67,6 +67,8 @@ void holdIsotropicStress(Simulation& sim, double pressure) {
 Laboratory::Laboratory(const RunConfig& config, ProgressFn progress)
     : config_(config), progress_(std::move(progress)) {
   sim_.boundary = config.test.boundary == "periodic" ? Boundary::Periodic : Boundary::Walls;
+  // Ellipsoid samples get the shape columns too (a_tau, a_E, ... of lab/micromechanics.hpp).
+  microColumns_.nonSpherical = config.sample.shape.type == "ellipsoid";
   static_assert(Record::kMicroColumns >= 11 + 2 + 6 * 3 + 2, "room for every micromechanical column");
 }
 

@@ -51,7 +51,7 @@ struct SampleConfig {
   // cube), compressed isotropically without friction (coordination 6).
   std::string method = "compaction";
   double growthRate = 2e-5;           // relative radius growth per step (method "growth")
-  double latticeJitter = 0.0;         // lattice + ellipsoids: random offsets before growth, fraction of d
+  double latticeJitter = 0.0;         // lattice: random offsets of the compressed lattice, fraction of d
   ShapeConfig shape;
 };
 

@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""[O]'s constant mean stress series, with spheroids and with spheres of the same volume.
+
+Usage: ouadfel_series.py OUT [--grainlab BIN] [--jobs 2] [--particles 343] [--doc docs/results]
+
+For each shape (prolate spheroids b/a = 0.7 of preset ouadfel-spheroids, and spheres of the same
+volume prepared the same way), the grown sample is made and tested at p = 100 kPa (kappa = 25);
+its packing file, unloaded by the cell's servo with friction on, gives the samples at 70, 50, 30
+and 10 kPa (kappa = 36, 50, 83, 250 with the same Kn), each tested at constant p to 20.5 % at an
+inertial number of 1e-4. Every run is one `grainlab run` (argument vector, no shell) into
+OUT/<shape>-<p>kPa. With --doc, writes the tables and plots of results/ouadfel.md there.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+PRESSURES_KPA = [100, 70, 50, 30, 10]
+SHAPES = {"spheroids": [], "spheres": ["--set", 'sample.shape.type="sphere"']}
+DENSITY, DIAMETER, KN, INERTIAL = 2600.0, 2e-3, 5000.0, 1e-4
+
+
+def rate(p):
+    """Axial strain rate of inertial number INERTIAL at mean stress p: I = rate d sqrt(rho / p)."""
+    return INERTIAL / (DIAMETER * math.sqrt(DENSITY / p))
+
+
+def run(args, name, sets):
+    out = os.path.join(args.out, name)
+    if os.path.exists(os.path.join(out, "summary.json")):
+        return out
+    argv = [args.grainlab, "run", "preset:ouadfel-spheroids", "--out", out, "--threads", "1", "--quiet",
+            "--set", f"sample.n_particles={args.particles}", *sets]
+    proc = subprocess.run(argv, capture_output=True, text=True)
+    if proc.returncode != 0:
+        sys.exit(f"{name}: grainlab exit {proc.returncode}\n{proc.stderr[-2000:]}")
+    return out
+
+
+def series(args):
+    def base(shape):
+        return run(args, f"{shape}-100kPa", SHAPES[shape] + ["--set", f"test.axial_strain_rate={rate(100e3)!r}"])
+
+    with ThreadPoolExecutor(args.jobs) as pool:
+        bases = dict(zip(SHAPES, pool.map(base, SHAPES)))
+        jobs = []
+        for shape in SHAPES:
+            packing = os.path.join(bases[shape], "packing.txt")
+            for p in PRESSURES_KPA[1:]:
+                sets = ["--set", f'sample.packing="{packing}"', "--set", f"test.confining_pressure={p * 1e3!r}",
+                        "--set", f"test.axial_strain_rate={rate(p * 1e3)!r}"]
+                jobs.append(pool.submit(run, args, f"{shape}-{p}kPa", sets))
+        for j in jobs:
+            j.result()
+
+
+def load(folder):
+    with open(os.path.join(folder, "timeseries.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    with open(os.path.join(folder, "summary.json")) as f:
+        summary = json.load(f)
+    return rows, summary
+
+
+def number(text):
+    return float(text) if text else float("nan")
+
+
+def document(args):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pictures = os.path.join(args.doc, "ouadfel")
+    os.makedirs(pictures, exist_ok=True)
+    table = []
+    fig, axes = plt.subplots(2, 3, figsize=(15, 8.5))
+    for row_axes, shape in zip(axes, SHAPES):
+        for p in PRESSURES_KPA:
+            rows, s = load(os.path.join(args.out, f"{shape}-{p}kPa"))
+            eps1 = [100 * number(r["eps1"]) for r in rows]
+            label = f"p = {p} kPa (kappa = {KN / (p * 1e3 * DIAMETER):.0f})"
+            row_axes[0].plot(eps1, [number(r["q"]) / number(r["p"]) for r in rows], lw=1.1, label=label)
+            row_axes[1].plot(eps1, [100 * number(r["eps_v"]) for r in rows], lw=1.1, label=label)
+            row_axes[2].plot(eps1, [number(r["Z"]) for r in rows], lw=1.1, label=label)
+            table.append((shape, p, KN / (p * 1e3 * DIAMETER), s))
+        row_axes[0].set_ylabel(f"{shape}: q/p")
+        row_axes[1].set_ylabel(f"{shape}: eps_v [%] (contraction > 0)")
+        row_axes[2].set_ylabel(f"{shape}: coordination Z")
+        for ax in row_axes:
+            ax.set_xlabel("axial strain eps1 [%]")
+            ax.grid(alpha=0.3)
+        row_axes[0].legend(fontsize=8)
+    fig.suptitle(f"[O] constant-p series, {args.particles} grains, periodic cell, mu = 0.5, Ks = Kn")
+    fig.tight_layout()
+    fig.savefig(os.path.join(pictures, "series.png"), dpi=100)
+    plt.close(fig)
+
+    # Growth curve of the spheroids (and the spheres' single relaxation).
+    _, s = load(os.path.join(args.out, "spheroids-100kPa"))
+    curve = s["growth_curve"]
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    e = [g["eccentricity"] for g in curve]
+    ax.errorbar(e, [g["Z"] for g in curve], yerr=[g["Z_std"] for g in curve], marker="o", ms=3, capsize=2,
+                label="Z (bars: spread over the grains)")
+    ax.set_xlabel("eccentricity (a - b)/(a + b)")
+    ax.set_ylabel("coordination number Z")
+    ax2 = ax.twinx()
+    ax2.plot(e, [g["packing_fraction"] for g in curve], "r--", marker="s", ms=3, label="packing fraction")
+    ax2.set_ylabel("packing fraction", color="r")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title("growth of aligned prolate spheroids at p = 100 kPa, mu = 0 (kappa = 25)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(pictures, "growth.png"), dpi=100)
+    plt.close(fig)
+
+    lines = ["| grains | p [kPa] | κ | e0 | Z0 | φp [°] | ε1 at peak [%] | φ at 20.5 % [°] | ψmax [°] | εv at 20.5 % [%] | Z at 20.5 % | steps | wall [s] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for shape, p, kappa, s in table:
+        rows, _ = load(os.path.join(args.out, f"{shape}-{p}kPa"))
+        last = rows[-1]
+        lines.append(f"| {shape} | {p} | {kappa:.0f} | {s['e0']:.3f} | {s['isotropic_state']['coordination']:.2f} | "
+                     f"{s['phi_peak_deg']:.1f} | {100 * s['eps1_at_peak']:.1f} | {number(last['phi_deg']):.1f} | "
+                     f"{s['psi_max_deg']:.1f} | {100 * number(last['eps_v']):.2f} | {number(last['Z']):.2f} | "
+                     f"{s['steps']} | {s['wall_seconds']:.0f} |")
+    growth = ["| eccentricity | Z | Z spread (std) | packing fraction |", "|---|---|---|---|"]
+    for g in curve:
+        growth.append(f"| {g['eccentricity']:.3f} | {g['Z']:.2f} | {g['Z_std']:.2f} | {g['packing_fraction']:.4f} |")
+    with open(os.path.join(pictures, "tables.md"), "w") as f:
+        f.write("\n".join(lines) + "\n\n" + "\n".join(growth) + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out")
+    ap.add_argument("--grainlab", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "grainlab"))
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--particles", type=int, default=343)
+    ap.add_argument("--doc", help="write results/ouadfel tables and plots into this folder")
+    args = ap.parse_args()
+    args.grainlab = os.path.abspath(args.grainlab)
+    os.makedirs(args.out, exist_ok=True)
+    series(args)
+    if args.doc:
+        document(args)
+
+
+if __name__ == "__main__":
+    main()
