@@ -223,7 +223,8 @@ PreparationResult Laboratory::adoptPacking(Simulation packed) {
   records_.sphericity = assignRollingFriction(config_, sim_.particles);
   for (Shape s : sim_.particles.shape) microColumns_.nonSpherical = microColumns_.nonSpherical || s == Shape::Ellipsoid;
   std::vector<double> diameters(sim_.particles.size());
-  for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.radius[i];
+  // Equivalent (equal-volume) diameters: the grading and d50 of ellipsoids are those of their volumes.
+  for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.equivalentRadius[i];
   result.grading = gradingStats(diameters);
   d50_ = result.grading.d50;
   configureSolver(config_, sim_);
