@@ -53,20 +53,29 @@ def main():
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--out", default=os.path.join(ROOT, "runs", "peer-periodic"))
     ap.add_argument("--doc", help="write the Markdown comparison here")
+    ap.add_argument("--reuse", action="store_true",
+                    help="keep the runs already in --out (prepared/, grainlab/, yade.csv) and only compare; the "
+                         "wall times are then those the runs recorded (grainlab's summary, YADE's yade.time)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     prep = os.path.join(a.out, "prepared")
     common = ["--set", f"sample.n_particles={a.particles}", "--threads", str(a.threads), "--quiet", *LAW]
-    run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", prep, "--set", 'test.type="isotropic"',
-         "--set", "output.plots=false", *common])
     packing = os.path.join(prep, "packing.txt")
     gl = os.path.join(a.out, "grainlab")
-    tg = run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", gl, "--set", f'sample.packing="{packing}"',
-              "--set", f"test.axial_strain_rate={a.rate}", "--set", f"test.final_axial_strain={a.strain}",
-              "--set", "output.plots=false", "--set", "output.vtk_every_strain=0", *common])
     yade_csv = os.path.join(a.out, "yade.csv")
-    ty = run(["yade", "-n", "-x", os.path.join(HERE, "yade_periodic.py"), packing, yade_csv,
-              "--strain", str(a.strain), "--rate", str(a.rate)])
+    if a.reuse:
+        tg = json.load(open(os.path.join(gl, "summary.json")))["wall_seconds"]
+        ty = float(open(yade_csv + ".time").read())
+    else:
+        run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", prep, "--set", 'test.type="isotropic"',
+             "--set", "output.plots=false", *common])
+        tg = run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", gl, "--set", f'sample.packing="{packing}"',
+                  "--set", f"test.axial_strain_rate={a.rate}", "--set", f"test.final_axial_strain={a.strain}",
+                  "--set", "output.plots=false", "--set", "output.vtk_every_strain=0", *common])
+        ty = run(["yade", "-n", "-x", os.path.join(HERE, "yade_periodic.py"), packing, yade_csv,
+                  "--strain", str(a.strain), "--rate", str(a.rate)])
+        with open(yade_csv + ".time", "w") as f:
+            f.write(f"{ty}\n")
     g = read(os.path.join(gl, "timeseries.csv"))
     y = read(yade_csv)
     summary = json.load(open(os.path.join(gl, "summary.json")))
