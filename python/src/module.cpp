@@ -266,21 +266,41 @@ class PySimulation {
     if (!std::isfinite(v)) throw py::value_error(fmt::format("{} = {}; allowed: a finite number", what, v));
   }
 
-  // Stress control of one axis: both walls of the axis (or the cell's diagonal component) servo
-  // to `stress` [Pa], compression positive.
-  void setStress(int axis, double stress) {
+  // Stress control of one axis: both walls of the axis, or only the lower (side 0) or upper (side 1)
+  // one, or the cell's diagonal component, servo to `stress` [Pa], compression positive.
+  void setStress(int axis, double stress, std::optional<int> side) {
     checkAxis(axis);
     checkFinite(stress, "stress");
     if (stress < 0.0) throw py::value_error(fmt::format("stress = {}; allowed: >= 0 (compression positive)", stress));
+    if (side && *side != 0 && *side != 1)
+      throw py::value_error(fmt::format("side = {}; allowed: 0 (lower wall), 1 (upper wall) or None (both)", *side));
     if (sim().boundary == Boundary::Periodic) {
+      if (side) throw py::value_error("side: a periodic cell has no walls; allowed: None");
       sim().cell.control[axis] = CellControl::Stress;
       sim().cell.targetStress[axis] = stress;
       return;
     }
-    for (int side = 0; side < 2; ++side) {
-      Wall& w = sim().box.walls[WallBox::index(axis, side)];
+    for (int k = 0; k < 2; ++k) {
+      if (side && k != *side) continue;
+      Wall& w = sim().box.walls[WallBox::index(axis, k)];
       w.control = WallControl::Stress;
       w.targetStress = stress;
+    }
+  }
+  // Simple shear of the cell: L_xz = rate (dx/dt = rate z) [1/s]; 0 stops it.
+  void setShearRate(double rate) {
+    checkFinite(rate, "rate");
+    if (sim().boundary != Boundary::Periodic)
+      throw py::value_error("set_shear_rate: only a periodic cell shears (test.boundary = \"periodic\")");
+    holdCellShape();
+    sim().cell.shearRate = rate;
+  }
+  // A strained cell keeps its principal axes (no shear servo), as the CLI's shearing tests do
+  // (lab/shear.cpp); hold_isotropic() gives the shear stresses back to their servo.
+  void holdCellShape() {
+    for (int k = 0; k < 3; ++k) {
+      if (sim().cell.shearControl[k] == CellControl::Stress) sim().cell.shearServoIntegral[k] = 0.0;
+      sim().cell.shearControl[k] = CellControl::StrainRate;
     }
   }
   // Strain control of one axis at an engineering rate of the reference length [1/s], compression
@@ -290,6 +310,7 @@ class PySimulation {
     checkAxis(axis);
     checkFinite(rate, "rate");
     if (sim().boundary == Boundary::Periodic) {
+      holdCellShape();
       sim().cell.control[axis] = CellControl::StrainRate;
       sim().cell.strainRate[axis] = rate;
       return;
@@ -451,7 +472,8 @@ PYBIND11_MODULE(_grainlab, m) {
            py::arg("progress") = py::none())
       .def("step", &PySimulation::step, py::arg("n") = 1)
       .def("reset_reference", &PySimulation::resetReference)
-      .def("set_stress", &PySimulation::setStress, py::arg("axis"), py::arg("stress"))
+      .def("set_stress", &PySimulation::setStress, py::arg("axis"), py::arg("stress"), py::arg("side") = py::none())
+      .def("set_shear_rate", &PySimulation::setShearRate, py::arg("rate"))
       .def("set_strain_rate", &PySimulation::setStrainRate, py::arg("axis"), py::arg("rate"))
       .def("hold_isotropic", [](PySimulation& s, double p) {
             PySimulation::checkFinite(p, "p");
