@@ -331,3 +331,25 @@ def test_run_and_sweep_on_a_dask_client_equal_the_local_ones(tmp_path):
     case = [r for name, r in swept.cases.items() if "0.15" in name]
     assert len(case) == 1
     assert without(case[0].summary, VOLATILE | {"threads"}) == without(local.summary, VOLATILE | {"threads"})
+
+
+def test_ctrl_c_during_preparation():
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        grainlab.Simulation("quick-triaxial", set={"sample.n_particles": 400}, threads=1)
+    timer.join()
+
+
+def test_sweep_and_run_refuse_with_the_cli_line(tmp_path):
+    proc = cli("sweep", "preset:quick-triaxial", "--vary", "contact.betta=0,1", "--out", str(tmp_path / "c"))
+    assert proc.returncode == 2
+    with pytest.raises(grainlab.ConfigError) as info:
+        grainlab.sweep("quick-triaxial", vary={"contact.betta": [0, 1]}, out=tmp_path / "p")
+    assert "grainlab: " + str(info.value) == proc.stderr.strip()
+    # A folder that is not grainlab's is never replaced (README "Results folder").
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(grainlab.ConfigError, match="mine"):
+        grainlab.run("quick-triaxial", set=SMALL, out=tmp_path / "mine", threads=1)
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
