@@ -5,7 +5,9 @@ the deviator has fallen back through zero into extension), on a small prepared s
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/custom_stress_path.py [OUT.png]
 
-Writes a PNG of q and the volumetric strain against the axial strain (about 20 s on one thread)."""
+Writes a PNG (default runs/custom-stress-path.png) of q and the volumetric strain against the
+axial strain (a few seconds on one thread)."""
+import os
 import sys
 
 import matplotlib
@@ -14,7 +16,8 @@ import matplotlib.pyplot as plt
 
 import grainlab
 
-out = sys.argv[1] if len(sys.argv) > 1 else "custom_stress_path.png"
+out = sys.argv[1] if len(sys.argv) > 1 else os.path.join("runs", "custom-stress-path.png")
+os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
 sim = grainlab.Simulation("quick-triaxial", set={"sample.n_particles": 150}, threads=1)
 p = sim.p  # the confining pressure the sample was prepared at
 rate = sim.inertial_rate(1e-3)  # quasi-static: inertial number 1e-3
