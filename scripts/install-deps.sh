@@ -10,6 +10,8 @@ PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli1
 PKGS+=(libxxhash-dev python3-xxhash)
 # grainlab calibrate (NLopt optimisers) and --scheduler (Dask distributed).
 PKGS+=(python3-nlopt python3-distributed)
+# The Python module (pybind11, headers of /usr/bin/python3) and Result.dataframe() (pandas).
+PKGS+=(pybind11-dev python3-dev python3-pandas)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/simulation.hpp"
+#include "lab/protocols.hpp"
 #include "lab/run_config.hpp"
 
 namespace grainlab::cli {
@@ -23,6 +24,10 @@ struct RunOptions {
 };
 // `grainlab run`: returns the exit code; throws InputError / SimulationError.
 int runLab(const RunOptions& options);
+// The same run of an already resolved config (the Python module's grainlab.run): options.config is
+// only the summary's config_source. `observer` also sees every progress report (and may throw
+// RunInterrupted to stop the run between steps).
+int runResolved(const lab::RunConfig& config, const RunOptions& options, const lab::ProgressFn& observer);
 struct ResumeOptions {
   std::string dir;
   bool quiet = false;

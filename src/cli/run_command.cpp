@@ -125,11 +125,14 @@ class RunSession {
   // Writes into folder.work(); messages name folder.target(), where the results end up.
   RunSession(const lab::RunConfig& config, const io::RunFolder& folder, bool quiet, json summary,
              double secondsBefore, std::vector<double> vtkLabels = {},
-             std::vector<io::MicroSnapshotInfo> microSnapshots = {})
+             std::vector<io::MicroSnapshotInfo> microSnapshots = {}, lab::ProgressFn observer = {})
       : config_(config), dir_(folder.work()), target_(folder.target()), quiet_(quiet), progress_(quiet),
         summary_(std::move(summary)), secondsBefore_(secondsBefore), t0_(std::chrono::steady_clock::now()),
         vtk_(dir_ / "vtk", std::move(vtkLabels)), micro_(dir_ / "micro", std::move(microSnapshots)),
-        lab_(config, [this](const std::string& phase, double f, long steps) { progress_.update(phase, f, steps); }) {
+        lab_(config, [this, observer = std::move(observer)](const std::string& phase, double f, long steps) {
+          progress_.update(phase, f, steps);
+          if (observer) observer(phase, f, steps);
+        }) {
     // The micromechanics snapshots (contact network, for `grainlab analyse` and the rose diagrams)
     // are taken at the VTK snapshots' instants: the start, every vtk_every_strain and the end.
     if (config.output.vtkEveryStrain > 0.0)
@@ -264,11 +267,11 @@ class RunSession {
     return writeResults(records, summary_.value("preparation_steps", 0L));
   }
 
-  // A failed run still leaves a summary saying so (and nothing non-finite).
-  void writeFailure(const std::string& what) {
+  // A failed (or interrupted) run still leaves a summary saying so (and nothing non-finite).
+  void writeFailure(const SimulationError& e) {
     progress_.finish();
-    summary_["status"] = "failed";
-    summary_["error"] = what;
+    summary_["status"] = dynamic_cast<const RunInterrupted*>(&e) ? "interrupted" : "failed";
+    summary_["error"] = e.what();
     summary_["wall_seconds"] = seconds();
     io::writeFileAtomic(dir_ / "summary.json", jsonText(summary_));
   }
@@ -347,7 +350,7 @@ int finish(RunSession& session, const lab::RunConfig& config) {
   try {
     return config.test.type == "isotropic" ? session.finishIsotropic() : session.finishShear();
   } catch (const SimulationError& e) {
-    session.writeFailure(e.what());
+    session.writeFailure(e);
     throw;
   }
 }
@@ -376,8 +379,9 @@ int inFolder(io::RunFolder& folder, const std::function<int()>& body) {
 
 }  // namespace
 
-int runLab(const RunOptions& opt) {
-  const lab::RunConfig config = resolveConfig(opt);
+int runLab(const RunOptions& opt) { return runResolved(resolveConfig(opt), opt, {}); }
+
+int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::ProgressFn& observer) {
   // Every input file is read and checked before the results folder is touched.
   std::optional<Simulation> packed = loadInputFiles(config);
   omp_set_num_threads(config.solver.threads);
@@ -393,7 +397,7 @@ int runLab(const RunOptions& opt) {
     summary["test"] = config.test.type;
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
-    RunSession session(config, folder, opt.quiet, summary, 0.0);
+    RunSession session(config, folder, opt.quiet, summary, 0.0, {}, {}, observer);
     lab::Laboratory& lab = session.lab();
     try {
       const lab::PreparationResult prep = packed ? lab.adoptPacking(std::move(*packed)) : lab.prepare();
@@ -448,7 +452,7 @@ int runLab(const RunOptions& opt) {
                      (prep.state.boundaryStress.sum() / 3.0) / 1e3);
       }
     } catch (const SimulationError& e) {
-      session.writeFailure(e.what());
+      session.writeFailure(e);
       throw;
     }
     return finish(session, config);

@@ -16,4 +16,10 @@ struct SimulationError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A run stopped on request between steps (Ctrl-C in the Python module): handled as a failed run
+// whose summary says "interrupted"; the results folder is left as a killed run leaves it.
+struct RunInterrupted : SimulationError {
+  using SimulationError::SimulationError;
+};
+
 }  // namespace grainlab

@@ -15,7 +15,17 @@ fs::path executablePath() {
   return exe;
 }
 
+namespace {
+fs::path& dataDirOverride() {
+  static fs::path dir;
+  return dir;
+}
+}  // namespace
+
+void setDataDir(const fs::path& dir) { dataDirOverride() = dir; }
+
 fs::path dataDir() {
+  if (!dataDirOverride().empty()) return dataDirOverride();
   const fs::path bin = executablePath().parent_path();
   for (const fs::path& candidate : {bin.parent_path() / "share" / "grainlab", bin / "share" / "grainlab"}) {
     std::error_code ec;

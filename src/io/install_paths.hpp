@@ -14,8 +14,10 @@ namespace grainlab::io {
 
 // The running executable (/proc/self/exe).
 std::filesystem::path executablePath();
-// share/grainlab beside the executable (see above); empty when neither place exists.
+// share/grainlab beside the executable (see above); empty when neither place exists. A host that
+// is not the grainlab executable (the Python module inside python3) names the folder instead.
 std::filesystem::path dataDir();
+void setDataDir(const std::filesystem::path& dir);
 // A script of share/grainlab/tools; empty when it is not there.
 std::filesystem::path toolScript(const std::string& name);
 // Folder that the relative file names of a preset are resolved against (share/grainlab/presets).
