@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of one grainlab results folder: q-eps1, eps_v-eps1, phi-eps1, e-eps1 (PNG in DIR/plots).
+"""Plots of one grainlab results folder: q-eps1, eps_v-eps1, phi-eps1, e-eps1, energy (PNG in DIR/plots).
 
 Usage: plot_run.py DIR
 Reads DIR/timeseries.csv (and DIR/summary.json for the annotations). Signs as in PHYSICS.md §0:
@@ -84,6 +84,35 @@ def main(directory):
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     save(fig, os.path.join(out, "overview.png"))
+
+    # The energy ledger of the test ([W] §4.9, Figs. 20-21): the boundaries' work against where it
+    # went (stored elastic and kinetic energy, slip, rolling and damping dissipation), cumulative
+    # from the start of the test, and the residual of the balance.
+    terms = ("W_boundary", "E_elastic", "E_kinetic", "D_slip", "D_roll", "D_damping")
+    if all(k in data for k in terms):
+        start = {k: data[k][0] for k in terms}
+        fig, (ax, axr) = plt.subplots(1, 2, figsize=(11, 4.2))
+        ax.plot(eps1, [v - start["W_boundary"] for v in data["W_boundary"]], "k", lw=1.6, label="work of the boundaries")
+        stored = [(e - start["E_elastic"]) + (k - start["E_kinetic"]) for e, k in zip(data["E_elastic"], data["E_kinetic"])]
+        ax.plot(eps1, stored, lw=1.1, label="stored (elastic + kinetic)")
+        for key, label in (("D_slip", "Coulomb slip"), ("D_roll", "rolling / moment plasticity"), ("D_damping", "damping")):
+            ax.plot(eps1, [v - start[key] for v in data[key]], lw=1.1, label=label)
+        total = [s + (a - start["D_slip"]) + (b - start["D_roll"]) + (c - start["D_damping"])
+                 for s, a, b, c in zip(stored, data["D_slip"], data["D_roll"], data["D_damping"])]
+        ax.plot(eps1, total, "k:", lw=1.2, label="stored + dissipated")
+        ax.set_xlabel("axial strain eps1 [%]")
+        ax.set_ylabel("energy since the start of the test [J]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        if "energy_residual" in data:
+            axr.plot(eps1, [100.0 * v for v in data["energy_residual"]], lw=1.1)
+        axr.axhline(0.0, color="k", lw=0.5)
+        axr.set_xlabel("axial strain eps1 [%]")
+        axr.set_ylabel("balance residual [% of the boundary work]")
+        axr.grid(alpha=0.3)
+        fig.suptitle(title, fontsize=10)
+        fig.tight_layout()
+        save(fig, os.path.join(out, "energy.png"))
     return 0
 
 
