@@ -24,11 +24,14 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-# (case, label, overrides of preset:w-base)
+# (case, label, overrides of preset:w-base). loose-moment-free cannot reach e0 = 0.80 with this grading
+# in the wall box (mu_prep = 89 deg gives e = 0.749 for seed 1), so it runs at the loosest it reaches
+# (mu_prep = 89 deg, no search); "compaction" with contact moments reaches 0.80.
 CASES = [
-    ("loose", "e0 = 0.80, loose-moment-free",
-     ["sample.e0=0.80", 'sample.method="loose-moment-free"']),
+    ("loose", "loose-moment-free, mu_prep 89 deg",
+     ["sample.e0=0.75", 'sample.method="loose-moment-free"', "sample.prep_friction_deg=89"]),
     ("dense", "e0 = 0.60, compaction", ["sample.e0=0.60", 'sample.method="compaction"']),
+    ("loose80", "e0 = 0.80, compaction with moments", ["sample.e0=0.80", 'sample.method="compaction"']),
 ]
 COMMON = ["output.plots=false", "output.vtk_every_strain=0", "output.checkpoint_every=0.05"]
 
@@ -105,7 +108,7 @@ def report(args):
         return 1
     figdir = os.path.join(args.docs, "e0-study")
     os.makedirs(figdir, exist_ok=True)
-    colours = {"loose": "tab:blue", "dense": "tab:red"}
+    colours = {"loose": "tab:blue", "loose80": "tab:green", "dense": "tab:red"}
     styles = ["-", "--", ":", "-."]
     for name, key, scale, ylabel in [("q.png", "q", 1e-3, "deviator q [kPa]"),
                                      ("epsv.png", "eps_v", 100.0, "volumetric strain eps_v [%] (contraction +)"),
@@ -138,18 +141,21 @@ def report(args):
     for case, _, seed, _, sm, s in found:
         by.setdefault(seed, {})[case] = (sm, s)
     for seed, pair in sorted(by.items()):
-        if "loose" in pair:
-            sm, s = pair["loose"]
-            lines.append(f"| seed {seed}: loose contracts overall (εv > 0 at the end) | εv = {100 * s['eps_v'][-1]:.2f} % "
+        for loose in ("loose", "loose80"):
+            if loose not in pair:
+                continue
+            sm, s = pair[loose]
+            tag = f"seed {seed}, {loose} (e0 = {sm['e0']:.3f})"
+            lines.append(f"| {tag}: contracts overall (εv > 0 at the end) | εv = {100 * s['eps_v'][-1]:.2f} % "
                          f"→ {'met' if s['eps_v'][-1] > 0 else 'missed'} |")
             d = sm["phi_peak_deg"] - sm["phi_res_deg"]
-            lines.append(f"| seed {seed}: loose has no peak (φp − φres < 2°) | {d:.1f}° → {'met' if d < 2 else 'missed'} |")
-        if "loose" in pair and "dense" in pair:
-            (a, _), (b, _) = pair["loose"], pair["dense"]
-            dq = abs(a["cs_q_over_p"] - b["cs_q_over_p"])
-            de = abs(a["cs_void_ratio"] - b["cs_void_ratio"])
-            lines.append(f"| seed {seed}: same end state, q/p within 0.1 | {dq:.3f} → {'met' if dq <= 0.1 else 'missed'} |")
-            lines.append(f"| seed {seed}: same end state, e within 0.03 | {de:.3f} → {'met' if de <= 0.03 else 'missed'} |")
+            lines.append(f"| {tag}: no peak (φp − φres < 2°) | {d:.1f}° → {'met' if d < 2 else 'missed'} |")
+            if "dense" in pair:
+                b_ = pair["dense"][0]
+                dq = abs(sm["cs_q_over_p"] - b_["cs_q_over_p"])
+                de = abs(sm["cs_void_ratio"] - b_["cs_void_ratio"])
+                lines.append(f"| {tag} vs dense: same end state, q/p within 0.1 | {dq:.3f} → {'met' if dq <= 0.1 else 'missed'} |")
+                lines.append(f"| {tag} vs dense: same end state, e within 0.03 | {de:.3f} → {'met' if de <= 0.03 else 'missed'} |")
     path = os.path.join(args.docs, "e0-study-table.md")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -569,6 +569,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
         fail(key, show(*n), "the axial strains must be strictly increasing");
     }
   }
+  c.test.platenSlowdownUnbalanced =
+      t.number("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced, 0.0, 1.0, false, true,
+               "must be in [0, 1) (unbalanced-force ratio above which the platens slow down; 0: off)");
   c.test.unloadToQFraction = t.number("unload_to_q_fraction", c.test.unloadToQFraction, 0.0, 1.0, false, true,
                                       "must be in [0, 1) (an unload ends at this fraction of the deviator at reversal)");
   t.finish();
@@ -675,6 +678,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
     test.insert("unload_reload_at", at);
   }
   test.insert("unload_to_q_fraction", c.test.unloadToQFraction);
+  test.insert("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
   if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);
   else test.insert("shear_strain_rate", "auto");
   toml::table solver{{"damping", c.solver.damping},

@@ -19,7 +19,11 @@ std::optional<ElasticConstants> elasticFromIncrement(double ds1, double ds3, dou
   const double a = (de1 * -(ds1 + ds3) + 2.0 * ds3 * de3) / det;
   const double b = (ds1 * de3 - ds3 * de1) / det;
   if (!(a > 0.0) || !std::isfinite(a) || !std::isfinite(b)) return std::nullopt;
-  return ElasticConstants{1.0 / a, b / a};
+  // An isotropic elastic solid has -1 < nu < 1/2 (positive bulk and shear moduli); increments
+  // outside are those of a structure that rearranges (a house of cards creeping during the probe).
+  const double nu = b / a;
+  if (!(nu > -1.0 && nu < 0.5)) return std::nullopt;
+  return ElasticConstants{1.0 / a, nu};
 }
 
 std::optional<double> secantE50(const std::vector<double>& eps1, const std::vector<double>& q) {
@@ -168,7 +172,8 @@ ModulusProbe Laboratory::probeModuli() {
                                    "of isotropic elasticity from the increments of boundary stress and strain (what is "
                                    "left of dsigma3 corrected)",
                                    probe.strain, kProbeSteps)
-                     : std::string("not measured: the probe's increments give no positive modulus");
+                     : std::string("not measured: the probe's increments are not those of an isotropic elastic "
+                                   "solid (E <= 0 or nu outside (-1, 0.5)): the sample rearranged during the probe");
   return probe;
 }
 

@@ -18,7 +18,8 @@ struct ElasticConstants {
 // positive): d_eps1 = (d_s1 - 2 nu d_s3)/E and d_eps3 = (d_s3 - nu (d_s1 + d_s3))/E, solved for
 // 1/E and nu/E. With d_s3 = 0 (the lateral stress held exactly) it is E = d_s1/d_eps1 and
 // nu = -d_eps3/d_eps1; the general form removes what the lateral servo leaves of d_s3. Null when
-// the system is singular or E comes out non-positive.
+// the system is singular, E comes out non-positive or nu outside (-1, 1/2) (not an isotropic elastic
+// solid: the sample rearranged).
 std::optional<ElasticConstants> elasticFromIncrement(double dSigma1, double dSigma3, double dEps1, double dEps3);
 
 // What the probe measured, for the summary.

@@ -152,6 +152,10 @@ class Laboratory {
   static constexpr double kLoopSpeedFactor = 0.1;
   // Records during a loop every this fraction of output.record_every_strain of platen travel.
   static constexpr double kLoopRecordFraction = 1e-3;
+  // Platen slow-down: the unbalanced force is checked every kSlowdownCheckSteps steps; the speed
+  // never falls below kMinPlatenSlowdown of the loading speed.
+  static constexpr long kSlowdownCheckSteps = 10;
+  static constexpr double kMinPlatenSlowdown = 0.05;
   // A record of the current state; the boundary stresses are meanStress when given (the mean over
   // the recording interval, as a load cell reports it), else the instantaneous ones.
   Record measure(const Vec3* meanStress = nullptr, double meanShearStress = 0.0) const;
@@ -189,6 +193,7 @@ class Laboratory {
     double loopQ = 0.0;
     long loopEndStep = -1;
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
+    double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
   };
   // Platen speed factor of the current step: the start-up ramp, or a loop's (negative while unloading).
   double loadingFactor() const;

@@ -103,6 +103,9 @@ struct TestConfig {
   // at reversal, and the reload returns to the reversal strain.
   std::vector<double> unloadReloadAt;
   double unloadToQFraction = 0.5;
+  // Platens slow down while the unbalanced-force ratio exceeds this (speed x threshold/ratio, at
+  // least kMinPlatenSlowdown), so that the lateral servos can follow a collapse; 0: off.
+  double platenSlowdownUnbalanced = 0.0;
 };
 
 struct SolverConfig {

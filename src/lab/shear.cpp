@@ -172,13 +172,14 @@ void Laboratory::driveBoundary(double ramp) {
 
 double Laboratory::loadingFactor() const {
   const ShearState& st = shear_;
-  if (st.loopPhase == 1) return -kLoopSpeedFactor;
-  if (st.loopPhase == 2) return kLoopSpeedFactor;
+  if (st.loopPhase == 1) return -kLoopSpeedFactor * st.slowdown;
+  if (st.loopPhase == 2) return kLoopSpeedFactor * st.slowdown;
   const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps);
-  if (st.loopEndStep < 0) return ramp;
+  if (st.loopEndStep < 0) return ramp * st.slowdown;
   // After a loop the platens speed up again from the loop's speed over the same ramp.
-  return std::min(ramp, kLoopSpeedFactor + (1.0 - kLoopSpeedFactor) *
-                                               static_cast<double>(sim_.stepCount - st.loopEndStep) / st.rampSteps);
+  return st.slowdown * std::min(ramp, kLoopSpeedFactor + (1.0 - kLoopSpeedFactor) *
+                                                             static_cast<double>(sim_.stepCount - st.loopEndStep) /
+                                                             st.rampSteps);
 }
 
 void Laboratory::beginShear() {
@@ -244,6 +245,14 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     *strain = testStrain();
     *last = *strain >= final;
   });
+  if (t.platenSlowdownUnbalanced > 0.0)
+    pipeline.addAfter("platen slow-down", [this, &st] {
+      // A collapsing column shows as a burst of unbalanced force: the platens hold back while it
+      // lasts, so that the lateral walls can follow the sudden contraction.
+      const double threshold = config_.test.platenSlowdownUnbalanced;
+      const double unbalanced = unbalancedForceRatio(sim_);
+      st.slowdown = unbalanced > threshold ? std::max(kMinPlatenSlowdown, threshold / unbalanced) : 1.0;
+    }, Pipeline::Trigger::onlyIf([this] { return sim_.stepCount % kSlowdownCheckSteps == 0; }));  // resumes in phase
   if (!t.unloadReloadAt.empty())
     pipeline.addAfter("unload-reload", [this, &st, strain] {
       // Reversal at the loop's strain, turning point at the stated fraction of the deviator at

@@ -33,6 +33,11 @@ TEST(Moduli, ElasticConstantsFromAnIncrement) {
   EXPECT_FALSE(lab::elasticFromIncrement(0.0, 0.0, 1e-5, 0.0).has_value());
   // Extension for a compression increment: not an elastic modulus.
   EXPECT_FALSE(lab::elasticFromIncrement(1000.0, 0.0, -1e-5, 0.0).has_value());
+  // Lateral contraction larger than the axial one (measured on a house of cards, e0 = 0.81, Z = 0.7:
+  // nu = -1.2): not elastic; nor is nu = 0.6 (a dilating sample).
+  EXPECT_FALSE(lab::elasticFromIncrement(289.8, -1.67, 1e-6, 1.21e-6).has_value());
+  EXPECT_FALSE(lab::elasticFromIncrement(1000.0, 0.0, 1e-5, -0.6e-5).has_value());
+  EXPECT_TRUE(lab::elasticFromIncrement(1000.0, 0.0, 1e-5, -0.49e-5).has_value());
 }
 
 // Kondner's hyperbola q = eps/(a + b eps) (Duncan & Chang 1970), sheared to eps_f: q_peak =

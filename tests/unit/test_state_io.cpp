@@ -46,6 +46,7 @@ struct ShearStateMembers {
   double loopQ;
   long loopEndStep;
   bool forceRecord;
+  double slowdown;
 };
 
 }  // namespace
