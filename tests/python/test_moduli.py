@@ -13,7 +13,7 @@ SMALL = os.path.join(os.path.dirname(__file__), "..", "data", "small-triaxial.to
 @pytest.mark.parametrize("value,allowed", [
     ("[0.02, 0.01]", "strictly increasing"),
     ("[0.01, 0.01]", "strictly increasing"),
-    ("[0.06]", "below test.final_axial_strain"),
+    ("[0.5]", "below test.final_axial_strain"),
     ("[-0.01]", "below test.final_axial_strain"),
     ("[0.0]", "below test.final_axial_strain"),
     ('["a"]', "array of finite numbers"),
@@ -32,8 +32,8 @@ def test_unload_reload_only_for_triaxial(grainlab):
     assert "test.unload_reload_at" in proc.stderr and "only for test.type" in proc.stderr
 
 
-@pytest.mark.parametrize("key,value", [("test.probe_strain", "-1e-5"), ("test.probe_strain", "0.01"),
-                                       ("test.unload_to_q_fraction", "1.0"), ("test.unload_to_q_fraction", "-0.1")])
+@pytest.mark.parametrize("key,value", [("test.probe_strain", "-0.5"), ("test.probe_strain", "0.25"),
+                                       ("test.unload_to_q_fraction", "1.0"), ("test.unload_to_q_fraction", "-0.5")])
 def test_bad_probe_and_fraction_are_exit_2(grainlab, key, value):
     proc = grainlab("check", SMALL, "--set", f"{key}={value}", check=2)
     assert key in proc.stderr and value in proc.stderr and "must be in" in proc.stderr
