@@ -151,7 +151,7 @@ class Laboratory {
   // an unload (~1e-4 of strain) lasts several wave transit times of the sample.
   static constexpr double kLoopSpeedFactor = 0.1;
   // Records during a loop every this fraction of output.record_every_strain of platen travel.
-  static constexpr double kLoopRecordFraction = 1e-3;
+  static constexpr double kLoopRecordFraction = 1e-2;
   // Platen slow-down: the unbalanced force is checked every kSlowdownCheckSteps steps; the speed
   // never falls below kMinPlatenSlowdown of the loading speed.
   static constexpr long kSlowdownCheckSteps = 10;
