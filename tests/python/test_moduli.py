@@ -33,7 +33,8 @@ def test_unload_reload_only_for_triaxial(grainlab):
 
 
 @pytest.mark.parametrize("key,value", [("test.probe_strain", "-0.5"), ("test.probe_strain", "0.25"),
-                                       ("test.unload_to_q_fraction", "1.0"), ("test.unload_to_q_fraction", "-0.5")])
+                                       ("test.unload_to_q_fraction", "1.0"), ("test.unload_to_q_fraction", "-0.5"),
+                                       ("test.platen_slowdown_unbalanced", "1.5"), ("test.platen_slowdown_unbalanced", "-0.5")])
 def test_bad_probe_and_fraction_are_exit_2(grainlab, key, value):
     proc = grainlab("check", SMALL, "--set", f"{key}={value}", check=2)
     assert key in proc.stderr and value in proc.stderr and "must be in" in proc.stderr
