@@ -11,6 +11,7 @@ The objective compares the seed-mean of each output with its target:
 written as F = r.r with the residual vector r (one entry per scalar target, one per grid point of
 each curve quantity, the latter carrying 1/N so that a curve counts as one target of its weight)."""
 import csv
+import difflib
 import math
 
 import numpy as np
@@ -115,9 +116,13 @@ class Problem:
             try:
                 v = summary_value(summary, t["key"])
             except KeyError:
+                keys = numeric_keys(summary)
+                # The closest keys first: the whole list is cut to stay one readable line.
+                close = difflib.get_close_matches(t["key"], keys, n=3, cutoff=0.5)
+                hint = f"closest: {', '.join(close)}; " if close else ""
                 raise InputProblem(
                     f"target error: target {t['key']!r}: not a numeric key of summary.json "
-                    f"(numeric keys: {', '.join(numeric_keys(summary))[:600]})") from None
+                    f"({hint}numeric keys: {', '.join(keys)[:600]})") from None
             values[t["key"]] = v
             if v is None:
                 problem = problem or f"{t['key']} was not measured (null)"

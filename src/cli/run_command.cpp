@@ -56,6 +56,28 @@ json equilibriumJson(const lab::EquilibriumState& s) {
           {"void_ratio", s.voidRatio}};
 }
 
+// A summary number for the console, or "null".
+std::string shown(const json& v, const char* format) {
+  if (!v.is_number()) return "null";
+  char text[64];
+  std::snprintf(text, sizeof text, format, v.get<double>());
+  return text;
+}
+
+// The small-strain probe in the summary (lab/moduli.hpp). E_MPa and nu repeat E0_MPa and nu0 for
+// readers of earlier summaries.
+void probeJson(const lab::ModulusProbe& probe, json& s) {
+  const bool ok = probe.elastic.has_value();
+  s["E0_MPa"] = ok ? json(finite(probe.elastic->young / 1e6, "E0_MPa")) : json(nullptr);
+  s["nu0"] = ok ? json(finite(probe.elastic->poisson, "nu0")) : json(nullptr);
+  s["E0_method"] = probe.method;
+  s["E0_probe"] = {{"strain", probe.strain}, {"d_sigma1", probe.dSigma1}, {"d_sigma3", probe.dSigma3},
+                   {"d_eps1", probe.dEps1}, {"d_eps3", probe.dEps3}, {"steps", probe.steps},
+                   {"settled", probe.settled}};
+  s["E_MPa"] = s["E0_MPa"];
+  s["nu"] = s["nu0"];
+}
+
 // JSON text of a summary; a path that is not UTF-8 (config_source) is written with U+FFFD in
 // place of its invalid bytes rather than failing the run.
 std::string jsonText(const json& j) { return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n"; }
@@ -189,7 +211,14 @@ class RunSession {
     const std::vector<lab::Record>& records = shear.records;
     const bool simpleShear = config_.test.type == "simple-shear";
     lab::TriaxialCurves curves;
+    // Unload–reload loops: the macro-parameters of the monotonic curve; the loops give Eur.
+    std::vector<double> loopEps1, loopQ;
+    std::vector<int> loopPhase;
     for (const auto& r : records) {
+      loopEps1.push_back(r.eps1);
+      loopQ.push_back(r.q);
+      loopPhase.push_back(static_cast<int>(r.loopPhase));
+      if (r.loopPhase != 0) continue;
       curves.eps1.push_back(simpleShear ? r.gamma : r.eps1);
       curves.epsV.push_back(r.epsV);
       curves.sigma1.push_back(r.sigma1);
@@ -205,20 +234,21 @@ class RunSession {
     summary_["q_peak"] = m.qPeak;
     summary_["phi_res_deg"] = finite(m.phiResDeg, "phi_res_deg");
     summary_["residual_window_eps1"] = {m.residualFrom, records.back().eps1};
-    summary_["psi_max_deg"] = finite(m.psiMaxDeg, "psi_max_deg");
+    summary_["psi_max_deg"] = m.psiMaxDeg ? json(finite(*m.psiMaxDeg, "psi_max_deg")) : json(nullptr);
     summary_["eps1_at_psi_max"] = m.eps1AtPsiMax;
     if (simpleShear) {
       // Simple shear measures a shear modulus; Young's modulus and Poisson's ratio are not measured.
       summary_["G_MPa"] = finite(m.shearModulus / 1e6, "G_MPa");
-      summary_["E_MPa"] = nullptr;
       summary_["E50_MPa"] = nullptr;
-      summary_["nu"] = nullptr;
+      summary_["E50_method"] = "not measured (simple shear)";
       summary_["final_shear_strain"] = records.back().gamma;
     } else {
-      summary_["E_MPa"] = finite(m.youngModulus / 1e6, "E_MPa");
-      summary_["E50_MPa"] = finite(m.e50 / 1e6, "E50_MPa");
-      summary_["nu"] = finite(m.poisson, "nu");
+      summary_["E50_MPa"] = m.e50 ? json(finite(*m.e50 / 1e6, "E50_MPa")) : json(nullptr);
+      summary_["E50_method"] = m.e50 ? "secant from the start of shearing to q = q_peak/2 (q_peak the largest deviator "
+                                       "of the monotonic curve), interpolated between records"
+                                     : "not measured (q never reached half its peak above its start)";
     }
+    moduliFromLoops(lab::unloadReloadLoops(loopEps1, loopQ, loopPhase));
     summary_["cs_q_over_p"] = m.csStressRatio;
     summary_["cs_void_ratio"] = m.csVoidRatio;
     summary_["strain_rate"] = shear.strainRate;
@@ -267,6 +297,26 @@ class RunSession {
     return writeResults(records, summary_.value("preparation_steps", 0L));
   }
 
+  // Eur of each unload–reload loop (lab/moduli.hpp); null when the test had no loop.
+  void moduliFromLoops(const std::vector<lab::UnloadReloadLoop>& loops) {
+    if (loops.empty()) {
+      summary_["Eur_MPa"] = nullptr;
+      summary_["Eur_method"] = "not measured (no test.unload_reload_at)";
+      return;
+    }
+    json eur = json::array(), at = json::array();
+    for (const auto& l : loops) {
+      eur.push_back(l.eur ? json(finite(*l.eur / 1e6, "Eur_MPa")) : json(nullptr));
+      at.push_back(l.eps1Reversal);
+    }
+    summary_["Eur_MPa"] = eur;
+    summary_["Eur_at_eps1"] = at;
+    summary_["Eur_method"] = fmt::format(
+        "per loop: secant of the reload branch, from the turning point (unloaded to q = {} q at reversal) to where "
+        "the reload regains the reversal strain; platens at {} of the loading speed",
+        config_.test.unloadToQFraction, lab::Laboratory::kLoopSpeedFactor);
+  }
+
   // A failed (or interrupted) run still leaves a summary saying so (and nothing non-finite).
   void writeFailure(const SimulationError& e) {
     progress_.finish();
@@ -293,16 +343,17 @@ class RunSession {
     if (!micro_.snapshots().empty()) analyseMicro();
     if (!quiet_) {
       if (summary_.contains("G_MPa"))
-        std::printf("phi_peak = %.2f deg at gamma = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, G = %.1f MPa\n",
+        std::printf("phi_peak = %.2f deg at gamma = %.4f, phi_res = %.2f deg, psi_max = %s deg, G = %.1f MPa\n",
                     summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
-                    summary_["phi_res_deg"].get<double>(), summary_["psi_max_deg"].get<double>(),
+                    summary_["phi_res_deg"].get<double>(), shown(summary_["psi_max_deg"], "%.2f").c_str(),
                     summary_["G_MPa"].get<double>());
       else if (summary_.contains("phi_peak_deg"))
-        std::printf("phi_peak = %.2f deg at eps1 = %.4f, phi_res = %.2f deg, psi_max = %.2f deg, "
-                    "E = %.1f MPa, nu = %.3f\n",
+        std::printf("phi_peak = %.2f deg at eps1 = %.4f, phi_res = %.2f deg, psi_max = %s deg, E0 = %s MPa, "
+                    "nu0 = %s, E50 = %s MPa\n",
                     summary_["phi_peak_deg"].get<double>(), summary_["eps1_at_peak"].get<double>(),
-                    summary_["phi_res_deg"].get<double>(), summary_["psi_max_deg"].get<double>(),
-                    summary_["E_MPa"].get<double>(), summary_["nu"].get<double>());
+                    summary_["phi_res_deg"].get<double>(), shown(summary_["psi_max_deg"], "%.2f").c_str(),
+                    shown(summary_["E0_MPa"], "%.1f").c_str(), shown(summary_["nu0"], "%.3f").c_str(),
+                    shown(summary_["E50_MPa"], "%.1f").c_str());
       std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, io::printable(target_.native(), 240).c_str());
     }
     return 0;
@@ -431,6 +482,15 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
         s["mu_r_max"] = *std::max_element(mu.begin(), mu.end());
       }
       s["isotropic_state"] = equilibriumJson(prep.state);
+      // Coordination after preparation; a sample standing at Z < 2 is a house of cards (tenuous
+      // arches held by contact moments) that collapses at the first load.
+      s["Z"] = prep.coordination.Z;
+      s["Z_mech"] = prep.coordination.Zmech ? json(*prep.coordination.Zmech) : json(nullptr);
+      s["rattler_fraction"] = prep.coordination.rattlerFraction;
+      s["house_of_cards"] = prep.coordination.Z < 2.0;
+      if (prep.coordination.Z < 2.0)
+        std::fprintf(stderr, "grainlab: warning: the prepared sample stands at Z = %.2f < 2 (a house of cards)\n",
+                     prep.coordination.Z);
       s["dt"] = sim.dt;
       s["dt_critical"] = sim.criticalTimeStep();
       s["preparation_steps"] = prep.steps;
@@ -442,6 +502,7 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
                            {"packing_fraction", g.packingFraction}});
         s["growth_curve"] = curve;
       }
+      probeJson(lab.probeModuli(), s);
       if (!opt.quiet) {
         const std::string how =
             !config.sample.packing.empty()            ? std::string("from the packing file")

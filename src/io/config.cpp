@@ -458,7 +458,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
   c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
-  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice"});
+  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice", "loose-moment-free"});
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
@@ -472,6 +472,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     if (side * side * side != n)
       fail("sample.n_particles", std::to_string(n), "must be a cube n^3 (e.g. 512, 1000) for sample.method = \"lattice\"");
   }
+  if (c.sample.shape.type == "ellipsoid" && c.sample.method == "loose-moment-free")
+    fail("sample.method", "\"loose-moment-free\"", "is for spheres (contact moments off during compaction); "
+         "ellipsoids: \"compaction\", \"growth\" or \"lattice\"");
   if (c.sample.shape.type == "ellipsoid" && c.sample.method == "compaction" && !c.sample.prepFrictionDeg)
     fail("sample.prep_friction_deg", "\"auto\"",
          "cannot search e0 for ellipsoids (their frictionless growth after compaction changes e); give an angle, "
@@ -555,6 +558,26 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     }
   }
   c.test.finalShearStrain = t.number("final_shear_strain", c.test.finalShearStrain, 0.0, 2.0, true, false, "must be in (0, 2]");
+  c.test.probeStrain = t.number("probe_strain", c.test.probeStrain, 0.0, 1e-3, false, false,
+                                "must be in [0, 1e-3] (axial strain of the small-strain probe; 0: no probe)");
+  if (const toml::node* n = t.raw("unload_reload_at")) {
+    const std::string key = t.path("unload_reload_at");
+    c.test.unloadReloadAt = t.numbers(*n, key);
+    if (c.test.type != "triaxial")
+      fail(key, show(*n), fmt::format("only for test.type = \"triaxial\" (here \"{}\")", c.test.type));
+    for (std::size_t i = 0; i < c.test.unloadReloadAt.size(); ++i) {
+      const double v = c.test.unloadReloadAt[i];
+      if (!(v > 0.0) || !(v < c.test.finalAxialStrain))
+        fail(key, show(*n), fmt::format("every axial strain must be in (0, {}) (below test.final_axial_strain)", c.test.finalAxialStrain));
+      if (i > 0 && !(v > c.test.unloadReloadAt[i - 1]))
+        fail(key, show(*n), "the axial strains must be strictly increasing");
+    }
+  }
+  c.test.platenSlowdownUnbalanced =
+      t.number("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced, 0.0, 1.0, false, true,
+               "must be in [0, 1) (unbalanced-force ratio above which the platens slow down; 0: off)");
+  c.test.unloadToQFraction = t.number("unload_to_q_fraction", c.test.unloadToQFraction, 0.0, 1.0, false, true,
+                                      "must be in [0, 1) (an unload ends at this fraction of the deviator at reversal)");
   t.finish();
 
   Section so(root, "solver");
@@ -654,6 +677,14 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                    {"final_shear_strain", c.test.finalShearStrain}};
   if (c.test.axialStrainRate) test.insert("axial_strain_rate", *c.test.axialStrainRate);
   else test.insert("axial_strain_rate", "auto");
+  test.insert("probe_strain", c.test.probeStrain);
+  if (!c.test.unloadReloadAt.empty()) {
+    toml::array at;
+    for (double v : c.test.unloadReloadAt) at.push_back(v);
+    test.insert("unload_reload_at", at);
+  }
+  test.insert("unload_to_q_fraction", c.test.unloadToQFraction);
+  test.insert("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
   if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);
   else test.insert("shear_strain_rate", "auto");
   toml::table solver{{"damping", c.solver.damping},

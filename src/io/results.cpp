@@ -45,6 +45,7 @@ TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
   c.periodic = config.test.boundary == "periodic";
   c.simpleShear = config.test.type == "simple-shear";
   c.trueTriaxial = config.test.type == "true-triaxial";
+  c.loops = !config.test.unloadReloadAt.empty();
   return c;
 }
 
@@ -58,6 +59,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   if (columns.trueTriaxial) s += ",b";
   s += ",energy_residual";
   for (const auto& name : columns.micro) s += "," + name;
+  if (columns.loops) s += ",loop_phase";
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -88,6 +90,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
     if (columns.trueTriaxial) nullable(r.b);
     nullable(r.energyResidual);
     for (std::size_t k = 0; k < columns.micro.size(); ++k) nullable(r.micro.at(k));
+    if (columns.loops) s += fmt::format(",{}", r.loopPhase);
     s += '\n';
   }
   return s;

@@ -21,6 +21,8 @@ struct TimeseriesColumns {
   // The micromechanical columns of the records (Laboratory::microColumnNames), after
   // energy_residual; their NaNs (not measurable) are written as empty fields.
   std::vector<std::string> micro;
+  // Unload–reload loops configured: loop_phase (Record::loopPhase) after the micromechanics.
+  bool loops = false;
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/types.hpp"
+#include "lab/moduli.hpp"
 
 namespace grainlab::lab {
 
@@ -68,7 +69,6 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
   }
 
   // Dilatancy: centred least-squares slope of eps_v on eps1.
-  m.psiMaxDeg = -90.0;
   std::size_t lo = 0, hi = 0;
   for (std::size_t i = 0; i < n; ++i) {
     while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
@@ -79,28 +79,12 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
     // (r < 2); a sudden collapse (eps_v growing faster than 2 eps1) has no dilatancy angle.
     if (rate >= 1.0) continue;
     const double psi = dilatancyAngleDeg(rate);
-    if (psi > m.psiMaxDeg) {
+    if (!m.psiMaxDeg || psi > *m.psiMaxDeg) {
       m.psiMaxDeg = psi;
       m.eps1AtPsiMax = c.eps1[i];
     }
   }
-  if (m.psiMaxDeg == -90.0) m.psiMaxDeg = 0.0;
-
-  // Small-strain stiffness.
-  std::size_t end = 0;
-  while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
-  end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));
-  m.youngModulus = slope(c.eps1, q, 0, end);
-  m.poisson = 0.5 * (1.0 - slope(c.eps1, c.epsV, 0, end));
-  const double half = 0.5 * m.qPeak;
-  for (std::size_t i = 1; i < n; ++i) {
-    if (q[i] >= half) {
-      const double f = (half - q[i - 1]) / (q[i] - q[i - 1]);
-      const double e = c.eps1[i - 1] + f * (c.eps1[i] - c.eps1[i - 1]);
-      m.e50 = e > 0.0 ? (half - q[0]) / (e - c.eps1[0]) : 0.0;
-      break;
-    }
-  }
+  m.e50 = secantE50(c.eps1, q);
   return m;
 }
 
@@ -132,19 +116,17 @@ MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSett
     m.csStressRatio = sumRatio / count;
     m.csVoidRatio = sumE / count;
   }
-  m.psiMaxDeg = -90.0;
   std::size_t lo = 0, hi = 0;
   for (std::size_t i = 0; i < n; ++i) {
     while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
     while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
     if (hi - lo < 3) continue;
     const double psi = radToDeg(std::atan(-slope(c.eps1, c.epsV, lo, hi)));
-    if (psi > m.psiMaxDeg) {
+    if (!m.psiMaxDeg || psi > *m.psiMaxDeg) {
       m.psiMaxDeg = psi;
       m.eps1AtPsiMax = c.eps1[i];
     }
   }
-  if (m.psiMaxDeg == -90.0) m.psiMaxDeg = 0.0;
   std::size_t end = 0;
   while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
   end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));

@@ -1,6 +1,7 @@
 #pragma once
 // Macro-parameters of a drained triaxial test from its recorded curves (PHYSICS.md §7.3).
 // Pure functions of the curves, so they can be tested on synthetic data with known answers.
+#include <optional>
 #include <vector>
 
 namespace grainlab::lab {
@@ -19,8 +20,10 @@ struct TriaxialCurves {
 //  - dilatancy rate: local least-squares slope r = d(eps_v)/d(eps1) over a centred window of
 //    +-dilatancyHalfWindow axial strain (default 0.005); windows with r >= 1 (sudden collapse,
 //    where sin psi = -r/(2 - r) leaves [-1, 1]) are skipped;
-//  - E and nu: least-squares slopes of q and eps_v on eps1 over eps1 <= elasticWindow (0.1 %),
-//    at least the first 3 records after the start; E50 the secant to half the peak q.
+//  - E50: the secant to half the peak q (lab/moduli.hpp); the small-strain E0 and nu0 come from
+//    a dedicated probe (Laboratory::probeModuli), not from these curves;
+//  - simple shear's G: least-squares slope of tau on gamma over gamma <= elasticWindow (0.1 %), at
+//    least the first 3 records.
 struct MacroSettings {
   double residualFraction = 0.2;
   double dilatancyHalfWindow = 0.005;
@@ -33,11 +36,9 @@ struct MacroParameters {
   double qPeak = 0.0;
   double phiResDeg = 0.0;
   double residualFrom = 0.0;  // eps1 where the residual window starts
-  double psiMaxDeg = 0.0;
+  std::optional<double> psiMaxDeg;  // null when no window could be evaluated
   double eps1AtPsiMax = 0.0;
-  double youngModulus = 0.0;  // [Pa]
-  double e50 = 0.0;           // [Pa]
-  double poisson = 0.0;
+  std::optional<double> e50;        // [Pa]; null when not measurable (lab/moduli.hpp)
   double csStressRatio = 0.0;  // q/p over the residual window (simple shear: tau/sigma_n)
   double csVoidRatio = 0.0;
   double shearModulus = 0.0;  // simple shear: least-squares slope of tau on gamma in the elastic window [Pa]
@@ -54,7 +55,7 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s = {
 // Simple shear at constant normal stress: `eps1` holds gamma, `sigma1` the normal stress, and
 // `shearStress` tau. phi = atan(tau / sigma_n); psi = atan(-d eps_v / d gamma) (positive in
 // dilation); G the slope of tau on gamma over gamma <= elasticWindow; windows as for computeMacro.
-// E, E50 and nu stay 0 (not measured by this test).
+// E50 stays null (not measured by this test).
 MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSettings& s = {});
 
 }  // namespace grainlab::lab

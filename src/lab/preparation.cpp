@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "lab/measurements.hpp"
+#include "lab/micro_network.hpp"
 #include "lab/placement.hpp"
 #include "lab/protocols.hpp"
 #include "geometry/ellipsoid_shape.hpp"
@@ -24,9 +25,19 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   sim_.localDamping = config_.sample.prepDamping;
   setFriction(muDeg);
   if (config_.sample.method == "growth") steps += growRadii();
+  // "loose-moment-free": no contact moments while the skeleton forms (Kozicki–Donze: no rolling
+  // stiffness; rolling-linear: no rolling friction); configureSolver() below and the saved rolling
+  // friction switch them on again, from zero moment, before the full-stiffness equilibrium.
+  const bool momentFree = config_.sample.method == "loose-moment-free";
+  const std::vector<double> rollingFriction = sim_.particles.rollingFriction;
+  if (momentFree) {
+    sim_.model.beta = 0.0;
+    std::fill(sim_.particles.rollingFriction.begin(), sim_.particles.rollingFriction.end(), 0.0);
+  }
+  const bool searched = config_.sample.method == "compaction" || momentFree;
   steps += consolidate(config_.test.confiningPressure,
-                       config_.sample.method == "compaction" ? fmt::format("compaction (mu_prep {:.1f} deg)", muDeg)
-                                                             : std::string("isotropic compression"));
+                       searched ? fmt::format("compaction (mu_prep {:.1f} deg{})", muDeg, momentFree ? ", no moments" : "")
+                                : std::string("isotropic compression"));
   // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
   // from the compressed lattice is not affine. sample.lattice_jitter moves every grain of the
   // compressed lattice by up to that fraction of its diameter along each axis (small beside the
@@ -48,6 +59,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   }
   if (config_.sample.shape.type == "ellipsoid") steps += growShapes();
   steps += rampStiffness();
+  if (momentFree) sim_.particles.rollingFriction = rollingFriction;
   configureSolver(config_, sim_);
   steps += consolidate(config_.test.confiningPressure, "equilibrium at full stiffness and friction");
   out = sim_;
@@ -102,7 +114,7 @@ PreparationResult Laboratory::prepare() {
     return e;
   };
 
-  if (config_.sample.method != "compaction") {
+  if (config_.sample.method != "compaction" && config_.sample.method != "loose-moment-free") {
     trial(0.0);  // frictionless growth or lattice: the e0 reached is the result, not a target
   } else if (config_.sample.prepFrictionDeg) {
     trial(*config_.sample.prepFrictionDeg);
@@ -150,6 +162,7 @@ PreparationResult Laboratory::prepare() {
   result.growth = growthCurve_;
   records_.reset(sim_);
   result.state = equilibriumState();
+  result.coordination = coordination(microNetwork(sim_));
   return result;
 }
 
@@ -232,6 +245,7 @@ PreparationResult Laboratory::adoptPacking(Simulation packed) {
   result.e0 = voidRatio(sim_);
   records_.reset(sim_);
   result.state = equilibriumState();
+  result.coordination = coordination(microNetwork(sim_));
   return result;
 }
 

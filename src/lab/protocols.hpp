@@ -17,6 +17,7 @@
 #include "lab/grain_records.hpp"
 #include "lab/kinematics.hpp"
 #include "lab/micromechanics.hpp"
+#include "lab/moduli.hpp"
 #include "lab/run_config.hpp"
 
 namespace grainlab::lab {
@@ -59,6 +60,9 @@ struct Record {
   // Energy balance ([W] §4.9, PHYSICS.md §7.6) since the start of shearing, as a fraction of the
   // external work: (W - dE_elastic - dE_kinetic - D_slip - D_roll - D_damping) / W; NaN while W = 0.
   double energyResidual = 0.0;
+  // Triaxial unload–reload loops (test.unload_reload_at): 0 monotonic loading, 1 unloading,
+  // 2 reloading.
+  long loopPhase = 0;
 };
 
 struct EquilibriumState {
@@ -85,6 +89,9 @@ struct PreparationResult {
   long steps = 0;
   GradingStats grading{};
   EquilibriumState state{};
+  // Coordination of the prepared sample (docs/micromechanics.md §1): Z over every particle, Z_mech
+  // over the non-rattlers (null when every grain is a rattler).
+  Coordination coordination{};
 };
 
 struct ShearResult {
@@ -107,6 +114,14 @@ class Laboratory {
   // Starts from a given packing (particles and boundary already in `packed`): equilibrium at full
   // stiffness and friction at the confining pressure, no compaction and no e0 search.
   PreparationResult adoptPacking(Simulation packed);
+  // The small-strain probe of the consolidated sample (test.probe_strain, lab/moduli.hpp): E0 and
+  // nu0; the engine is left exactly as it was.
+  ModulusProbe probeModuli();
+  static constexpr double kProbeUnbalanced = 1e-3;
+  static constexpr double kProbeStressTolerance = 1e-3;  // reference state: stresses within 1e-3 p
+  static constexpr double kProbeLateralFraction = 1e-2;  // probed state: lateral within 1 % of d_sigma1
+  static constexpr long kProbeSteps = 1000;
+  static constexpr long kProbeMaxSteps = 2'000'000;
   // Shearing of the prepared sample to the final strain: beginShear() then continueShear().
   ShearResult shear();
   void beginShear();
@@ -141,6 +156,15 @@ class Laboratory {
   static constexpr double kNeighbourhoodDiameters = 2.0;
   static constexpr double kPlatenRampIntegralTimes = 40.0;
   static constexpr double kAutoInertialNumber = 0.98e-3;
+  // Platen speed during an unload–reload loop, as a fraction of the loading speed: slow enough that
+  // an unload (~1e-4 of strain) lasts several wave transit times of the sample.
+  static constexpr double kLoopSpeedFactor = 0.1;
+  // Records during a loop every this fraction of output.record_every_strain of platen travel.
+  static constexpr double kLoopRecordFraction = 1e-2;
+  // Platen slow-down: the unbalanced force is checked every kSlowdownCheckSteps steps; the speed
+  // never falls below kMinPlatenSlowdown of the loading speed.
+  static constexpr long kSlowdownCheckSteps = 10;
+  static constexpr double kMinPlatenSlowdown = 0.05;
   // A record of the current state; the boundary stresses are meanStress when given (the mean over
   // the recording interval, as a load cell reports it), else the instantaneous ones.
   Record measure(const Vec3* meanStress = nullptr, double meanShearStress = 0.0) const;
@@ -172,7 +196,16 @@ class Laboratory {
     long stressSamples = 0;
     double elastic0 = 0.0, kinetic0 = 0.0;  // energies at the start of shearing [J]
     ShearResult result;
+    // Unload–reload loops: the next loop of test.unload_reload_at, the current phase (as
+    // Record::loopPhase), the deviator at the reversal, the step the last loop ended (-1: none).
+    int loopNext = 0, loopPhase = 0;
+    double loopQ = 0.0;
+    long loopEndStep = -1;
+    bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
+    double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
   };
+  // Platen speed factor of the current step: the start-up ramp, or a loop's (negative while unloading).
+  double loadingFactor() const;
   ShearState shear_;
   Simulation sim_;
   GrainRecords records_;

@@ -49,6 +49,10 @@ struct SampleConfig {
   // the boundary held still up to the confining pressure (the densest state; e0 is a result).
   // "lattice" ([O] §5.1): equal spheres of diameter d50 on a simple cubic lattice (n_particles a
   // cube), compressed isotropically without friction (coordination 6).
+  // "loose-moment-free": as "compaction" (the same e0 search on the preparation friction), but with
+  // no contact moments during compaction (rolling stiffness 0); the moments are switched on at the
+  // full-stiffness equilibrium. Spheres that cannot resist rolling cannot stand in the tenuous arches
+  // that contact moments allow, so a loose target is met by a connected skeleton (docs/moduli.md).
   std::string method = "compaction";
   double growthRate = 2e-5;           // relative radius growth per step (method "growth")
   double latticeJitter = 0.0;         // lattice: random offsets of the compressed lattice, fraction of d
@@ -92,6 +96,17 @@ struct TestConfig {
   double b = 0.5;                     // true-triaxial: (sigma2 - sigma3)/(sigma1 - sigma3)
   std::optional<double> shearStrainRate;  // simple-shear [1/s]; nullopt = "auto"
   double finalShearStrain = 0.5;      // simple-shear: final gamma [-]
+  // Small-strain probe after consolidation (lab/moduli.hpp): axial strain increment with the
+  // lateral stress held; 0: no probe (E0, nu0 null).
+  double probeStrain = 1e-6;
+  // Triaxial: axial strains at which the platens reverse for an unload-reload loop (strictly
+  // increasing, in (0, final_axial_strain)); each unload ends at unloadToQFraction of the deviator
+  // at reversal, and the reload returns to the reversal strain.
+  std::vector<double> unloadReloadAt;
+  double unloadToQFraction = 0.5;
+  // Platens slow down while the unbalanced-force ratio exceeds this (speed x threshold/ratio, at
+  // least kMinPlatenSlowdown), so that the lateral servos can follow a collapse; 0: off.
+  double platenSlowdownUnbalanced = 0.0;
 };
 
 struct SolverConfig {

@@ -170,6 +170,18 @@ void Laboratory::driveBoundary(double ramp) {
   }
 }
 
+double Laboratory::loadingFactor() const {
+  const ShearState& st = shear_;
+  if (st.loopPhase == 1) return -kLoopSpeedFactor * st.slowdown;
+  if (st.loopPhase == 2) return kLoopSpeedFactor * st.slowdown;
+  const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps);
+  if (st.loopEndStep < 0) return ramp * st.slowdown;
+  // After a loop the platens speed up again from the loop's speed over the same ramp.
+  return st.slowdown * std::min(ramp, kLoopSpeedFactor + (1.0 - kLoopSpeedFactor) *
+                                                             static_cast<double>(sim_.stepCount - st.loopEndStep) /
+                                                             st.rampSteps);
+}
+
 void Laboratory::beginShear() {
   ShearState& st = shear_;
   st = ShearState{};
@@ -221,9 +233,7 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
   auto strain = std::make_shared<double>(0.0);
   auto last = std::make_shared<bool>(false);
 
-  pipeline.addBefore("loading drive", [this, &st] {
-    driveBoundary(std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps));
-  });
+  pipeline.addBefore("loading drive", [this] { driveBoundary(loadingFactor()); });
   pipeline.addAfter("rotation record", [this] { records_.accumulateRotation(sim_.particles, sim_.dt); });
   pipeline.addAfter("load cell", [this, &st, strain, last, final] {
     const Mat3 sc = sim_.boundary == Boundary::Periodic ? sim_.cell.stress : Mat3::Zero();
@@ -235,8 +245,41 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     *strain = testStrain();
     *last = *strain >= final;
   });
+  if (t.platenSlowdownUnbalanced > 0.0)
+    pipeline.addAfter("platen slow-down", [this, &st] {
+      // A collapsing column shows as a burst of unbalanced force: the platens hold back while it
+      // lasts, so that the lateral walls can follow the sudden contraction.
+      const double threshold = config_.test.platenSlowdownUnbalanced;
+      const double unbalanced = unbalancedForceRatio(sim_);
+      st.slowdown = unbalanced > threshold ? std::max(kMinPlatenSlowdown, threshold / unbalanced) : 1.0;
+    }, Pipeline::Trigger::onlyIf([this] { return sim_.stepCount % kSlowdownCheckSteps == 0; }));  // resumes in phase
+  if (!t.unloadReloadAt.empty())
+    pipeline.addAfter("unload-reload", [this, &st, strain] {
+      // Reversal at the loop's strain, turning point at the stated fraction of the deviator at
+      // reversal, end where the reload regains the reversal strain (the instantaneous wall stresses).
+      const std::vector<double>& at = config_.test.unloadReloadAt;
+      const Vec3 s = boundaryStress(sim_);
+      const double q = s[2] - 0.5 * (s[0] + s[1]);
+      const bool more = st.loopNext < static_cast<int>(at.size());
+      if (st.loopPhase == 0 && more && *strain >= at[st.loopNext]) {
+        st.loopPhase = 1;
+        st.loopQ = q;
+        st.forceRecord = true;
+      } else if (st.loopPhase == 1 && q <= config_.test.unloadToQFraction * st.loopQ) {
+        st.loopPhase = 2;
+        st.forceRecord = true;
+      } else if (st.loopPhase == 2 && *strain >= at[st.loopNext]) {
+        st.loopPhase = 0;
+        ++st.loopNext;
+        st.loopEndStep = sim_.stepCount;
+        st.forceRecord = true;
+      }
+    });
   pipeline.addAfter("record", [this, &st, strain, last, every, p] {
-    if (!(*strain >= st.nextRecord || *last)) return;
+    const bool loopDue = st.loopPhase != 0 && !st.result.records.empty() &&
+                         std::abs(*strain - st.result.records.back().eps1) >= kLoopRecordFraction * every;
+    if (!(*strain >= st.nextRecord || *last || st.forceRecord || loopDue)) return;
+    st.forceRecord = false;
     const double samples = static_cast<double>(st.stressSamples);
     const Vec3 meanStress = st.stressSum / samples;
     Record r = measure(&meanStress, st.shearStressSum / samples);
@@ -257,6 +300,7 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     st.shearStressSum = 0.0;
     st.wallStressSum.fill(0.0);
     st.stressSamples = 0;
+    r.loopPhase = st.loopPhase;
     st.result.records.push_back(r);
     while (st.nextRecord <= *strain) st.nextRecord += *strain < 0.01 ? 0.1 * every : every;
   });

@@ -21,7 +21,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # faster but arithmetically different contact kernel moved e0 by 0.01 and phi_peak by 3.6 deg).
 SEEDS = (7, 8, 9, 10, 11)
 CASES = {"kozicki-eta0.1": ["contact.eta=0.1"], "no-moments": ["contact.beta=0"]}
-FLOORS = {"e0": 0.01, "phi_peak_deg": 1.0, "phi_res_deg": 1.0, "psi_max_deg": 2.0, "E_MPa": 20.0,
+FLOORS = {"e0": 0.01, "phi_peak_deg": 1.0, "phi_res_deg": 1.0, "psi_max_deg": 2.0, "E0_MPa": 100.0,
           "cs_void_ratio": 0.02}
 
 

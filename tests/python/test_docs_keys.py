@@ -192,9 +192,11 @@ def test_timeseries_columns_are_documented_in_order(short_run):
     # The columns of the other tests, where results.cpp inserts them: before energy_residual.
     src = read("src", "io", "results.cpp")
     extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
-    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial"}, extra
+    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops"}, extra
     i = header.index("energy_residual")
-    expected = header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")] + header[i:]
+    # The unload-reload column comes last, after the micromechanics columns.
+    expected = (header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")]
+                + header[i:] + extra["loops"].split(","))
     rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
     documented = [n for cells in rows[2:] for n in names_in(cells[0])]
     assert documented == expected
@@ -204,6 +206,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "mu_r_mean", "mu_r_min", "mu_r_max",   # rolling-linear runs
     "G_MPa", "final_shear_strain",         # simple shear
     "growth_curve",                        # ellipsoid shape growth
+    "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
 }
 

@@ -43,14 +43,10 @@ TEST(Macro, KnownAnswersFromSyntheticCurves) {
   EXPECT_NEAR(m.eps1AtPeak, 0.02, 1e-12);
   EXPECT_NEAR(m.phiResDeg, 32.0, 1e-9);          // window eps1 >= 16 %
   EXPECT_NEAR(m.residualFrom, 0.16, 1e-12);
-  EXPECT_NEAR(m.psiMaxDeg, radToDeg(std::asin(0.5 / 2.5)), 1e-6);
+  ASSERT_TRUE(m.psiMaxDeg.has_value());
+  EXPECT_NEAR(*m.psiMaxDeg, radToDeg(std::asin(0.5 / 2.5)), 1e-6);
   EXPECT_GT(m.eps1AtPsiMax, 0.015);
   EXPECT_LT(m.eps1AtPsiMax, 0.095);
-  // Initial slope of q: q = s3 * 2 s/(1 - s) ~ 2 s3 (k e + k^2 e^2) with k = dphi/de (rad), so a
-  // least-squares line over [0, w] has slope 2 s3 k (1 + k w) to first order in k w.
-  const double k = degToRad(40.0) / 0.02, w = 0.001;
-  EXPECT_NEAR(m.youngModulus / (2.0 * 100e3 * k * (1.0 + k * w)), 1.0, 0.005);
-  EXPECT_NEAR(m.poisson, (1.0 - 0.25) / 2.0, 1e-9);
   // Critical state: q/p = 6 sin phi / (3 - sin phi) for triaxial compression.
   const double s = std::sin(degToRad(32.0));
   EXPECT_NEAR(m.csStressRatio, 6 * s / (3 - s), 1e-9);
@@ -61,5 +57,6 @@ TEST(Macro, KnownAnswersFromSyntheticCurves) {
   const double half = 0.5 * 100e3 * 2 * sp / (1 - sp);
   const double x = half / 100e3;
   const double eps50 = 0.02 * radToDeg(std::asin(x / (2 + x))) / 40.0;
-  EXPECT_NEAR(m.e50 / (half / eps50), 1.0, 0.005);
+  ASSERT_TRUE(m.e50.has_value());
+  EXPECT_NEAR(*m.e50 / (half / eps50), 1.0, 0.005);
 }

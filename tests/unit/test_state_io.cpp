@@ -42,6 +42,11 @@ struct ShearStateMembers {
   long stressSamples;
   double elastic0, kinetic0;
   lab::ShearResult result;
+  int loopNext, loopPhase;
+  double loopQ;
+  long loopEndStep;
+  bool forceRecord;
+  double slowdown;
 };
 
 }  // namespace
