@@ -111,13 +111,66 @@ GRAINLAB_ALWAYS_INLINE Vec3 wallPoint(const Wall& wall, const Vec3& x) {
   return p;
 }
 
-// The narrow phase and kinematics of one contact of a kind: fills geometry and kinematics and
-// returns false when the bodies are apart.
+// What every body pair of one kind shares: the kinematics at the contact point, the Ip2 parameters
+// from the two bodies' radii (the sphere radius, or an ellipsoid's volume-equivalent radius) and
+// the stored force and moment.
+template <class Kind, bool Periodic, bool EquivalentRadius>
+struct PairKernelBase {
+  using List = ContactList<Kind>;
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
+                                                                      const Vec3& branch) {
+    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
+    const auto& r = EquivalentRadius ? ctx.particles.equivalentRadius : ctx.particles.radius;
+    const auto& mu = ctx.particles.rollingFriction;
+    const std::uint32_t a = list.a[c], b = list.b[c];
+    return ctx.model.pairParams(r[a], r[b], mu[a], mu[b]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storePair(list, c, g, res);
+  }
+};
+
+// The same for a body (list.a) against a wall (list.b).
+template <class Kind, bool EquivalentRadius>
+struct WallKernelBase {
+  using List = ContactList<Kind>;
+  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
+                                                                      std::size_t c, const geometry::ContactGeometry& g,
+                                                                      const Vec3&) {
+    return wallKinematics(ctx, list.a[c], ctx.box.walls[list.b[c]], g);
+  }
+  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
+    const std::uint32_t i = list.a[c];
+    const double r = EquivalentRadius ? ctx.particles.equivalentRadius[i] : ctx.particles.radius[i];
+    return ctx.model.wallParams(r, ctx.box.walls[list.b[c]].tanFriction, ctx.particles.rollingFriction[i]);
+  }
+  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
+                                           const contact::ContactResponse& res) {
+    storeWall(list, c, g, res);
+  }
+};
+
+// An ellipsoid solve's outcome: keeps lambda and the potential length for the next step's warm start.
+GRAINLAB_ALWAYS_INLINE bool acceptEllipsoidContact(const geometry::EllipsoidContact& e, contact::EllipsoidHistory& h,
+                                                   geometry::ContactGeometry& g) {
+  if (!e.touching) return false;
+  h.lambda = e.lambda;
+  h.potentialLength = e.potentialLength;
+  g = e.geometry;
+  return true;
+}
+
+// The narrow phase of one contact of a kind: fills the geometry (and the branch vector of a pair)
+// and returns false when the bodies are apart.
 template <class Kind, bool Periodic>
 struct KindKernel;
 
 template <bool Periodic>
-struct KindKernel<SphereSphere, Periodic> {
+struct KindKernel<SphereSphere, Periodic> : PairKernelBase<SphereSphere, Periodic, false> {
   using List = ContactList<SphereSphere>;
   GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
                                               contact::ContactHistory&, geometry::ContactGeometry& g, Vec3& branch) {
@@ -130,27 +183,12 @@ struct KindKernel<SphereSphere, Periodic> {
     g = geometry::sphereSphere(branch, dist2, rad[a], rad[b]);
     return true;
   }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
-                                                                      std::size_t c, const geometry::ContactGeometry& g,
-                                                                      const Vec3& branch) {
-    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
-    const auto& rad = ctx.particles.radius;
-    const auto& mu = ctx.particles.rollingFriction;
-    const std::uint32_t a = list.a[c], b = list.b[c];
-    return ctx.model.pairParams(rad[a], rad[b], mu[a], mu[b]);
-  }
-  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
-                                           const contact::ContactResponse& res) {
-    storePair(list, c, g, res);
-  }
 };
 
+// The wall is body A, the sphere body B (the plane's normal points into the sphere's side).
 template <bool Periodic>
-struct KindKernel<SpherePlane, Periodic> {
+struct KindKernel<SpherePlane, Periodic> : WallKernelBase<SpherePlane, false> {
   using List = ContactList<SpherePlane>;
-  // The wall is body A, the sphere body B (the plane's normal points into the sphere's side).
   GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
                                               contact::ContactHistory&, geometry::ContactGeometry& g, Vec3&) {
     const std::uint32_t i = list.a[c];
@@ -159,27 +197,13 @@ struct KindKernel<SpherePlane, Periodic> {
     g = geometry::spherePlane(x, ctx.particles.radius[i], wallPoint(wall, x), wall.inwardNormal());
     return g.overlap > 0.0;
   }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
-                                                                      std::size_t c, const geometry::ContactGeometry& g,
-                                                                      const Vec3&) {
-    return wallKinematics(ctx, list.a[c], ctx.box.walls[list.b[c]], g);
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
-    const std::uint32_t i = list.a[c];
-    return ctx.model.wallParams(ctx.particles.radius[i], ctx.box.walls[list.b[c]].tanFriction,
-                                ctx.particles.rollingFriction[i]);
-  }
-  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
-                                           const contact::ContactResponse& res) {
-    storeWall(list, c, g, res);
-  }
 };
 
 // Ellipsoid pairs: bounding spheres, then the line-of-centres filter, then the Perram–Wertheim
 // solve warm-started from the lambda of the last step, with the potential length frozen when the
 // contact forms (docs/ellipsoids.md).
 template <bool Periodic>
-struct KindKernel<EllipsoidEllipsoid, Periodic> {
+struct KindKernel<EllipsoidEllipsoid, Periodic> : PairKernelBase<EllipsoidEllipsoid, Periodic, true> {
   using List = ContactList<EllipsoidEllipsoid>;
   GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
                                               contact::EllipsoidHistory& h, geometry::ContactGeometry& g,
@@ -190,33 +214,14 @@ struct KindKernel<EllipsoidEllipsoid, Periodic> {
     if (!geometry::boundingSpheresOverlap(branch, rad[a], rad[b])) return false;
     const auto& xs = *ctx.shapeMatrices;
     if (geometry::separatedAlongCentreLine(branch, xs[a], xs[b])) return false;
-    const geometry::EllipsoidContact e =
-        geometry::ellipsoidEllipsoid(branch, xs[a], xs[b], h.lambda, h.touching ? h.potentialLength : 0.0);
-    if (!e.touching) return false;
-    h.lambda = e.lambda;
-    h.potentialLength = e.potentialLength;
-    g = e.geometry;
-    return true;
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
-                                                                      std::size_t c, const geometry::ContactGeometry& g,
-                                                                      const Vec3& branch) {
-    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
-    const auto& r = ctx.particles.equivalentRadius;
-    const auto& mu = ctx.particles.rollingFriction;
-    return ctx.model.pairParams(r[list.a[c]], r[list.b[c]], mu[list.a[c]], mu[list.b[c]]);
-  }
-  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
-                                           const contact::ContactResponse& res) {
-    storePair(list, c, g, res);
+    return acceptEllipsoidContact(
+        geometry::ellipsoidEllipsoid(branch, xs[a], xs[b], h.lambda, h.touching ? h.potentialLength : 0.0), h, g);
   }
 };
 
 // A sphere (body a) and an ellipsoid (body b), solved in the ellipsoid's frame.
 template <bool Periodic>
-struct KindKernel<SphereEllipsoid, Periodic> {
+struct KindKernel<SphereEllipsoid, Periodic> : PairKernelBase<SphereEllipsoid, Periodic, true> {
   using List = ContactList<SphereEllipsoid>;
   GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
                                               contact::EllipsoidHistory& h, geometry::ContactGeometry& g,
@@ -225,33 +230,15 @@ struct KindKernel<SphereEllipsoid, Periodic> {
     const Particles& P = ctx.particles;
     branch = pairBranch<Periodic>(ctx, list, c);
     if (!geometry::boundingSpheresOverlap(branch, P.radius[a], P.radius[b])) return false;
-    const geometry::EllipsoidContact e = geometry::sphereEllipsoid(branch, P.radius[a], P.semiAxes[b], P.orientation[b],
-                                                                   h.lambda, h.touching ? h.potentialLength : 0.0);
-    if (!e.touching) return false;
-    h.lambda = e.lambda;
-    h.potentialLength = e.potentialLength;
-    g = e.geometry;
-    return true;
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
-                                                                      std::size_t c, const geometry::ContactGeometry& g,
-                                                                      const Vec3& branch) {
-    return pairKinematics<Periodic>(ctx, list.a[c], list.b[c], g, branch);
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
-    const auto& r = ctx.particles.equivalentRadius;
-    const auto& mu = ctx.particles.rollingFriction;
-    return ctx.model.pairParams(r[list.a[c]], r[list.b[c]], mu[list.a[c]], mu[list.b[c]]);
-  }
-  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
-                                           const contact::ContactResponse& res) {
-    storePair(list, c, g, res);
+    return acceptEllipsoidContact(geometry::sphereEllipsoid(branch, P.radius[a], P.semiAxes[b], P.orientation[b],
+                                                            h.lambda, h.touching ? h.potentialLength : 0.0),
+                                  h, g);
   }
 };
 
 // An ellipsoid (body B) against a wall (body A): the closed-form support point.
 template <bool Periodic>
-struct KindKernel<EllipsoidPlane, Periodic> {
+struct KindKernel<EllipsoidPlane, Periodic> : WallKernelBase<EllipsoidPlane, true> {
   using List = ContactList<EllipsoidPlane>;
   GRAINLAB_ALWAYS_INLINE static bool evaluate(const ContactContext& ctx, const List& list, std::size_t c,
                                               contact::ContactHistory&, geometry::ContactGeometry& g, Vec3&) {
@@ -262,20 +249,6 @@ struct KindKernel<EllipsoidPlane, Periodic> {
         geometry::ellipsoidPlane(x, (*ctx.shapeMatrices)[i], wallPoint(wall, x), wall.inwardNormal());
     g = e.geometry;
     return e.touching;
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::ContactKinematics kinematics(const ContactContext& ctx, const List& list,
-                                                                      std::size_t c, const geometry::ContactGeometry& g,
-                                                                      const Vec3&) {
-    return wallKinematics(ctx, list.a[c], ctx.box.walls[list.b[c]], g);
-  }
-  GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
-    const std::uint32_t i = list.a[c];
-    return ctx.model.wallParams(ctx.particles.equivalentRadius[i], ctx.box.walls[list.b[c]].tanFriction,
-                                ctx.particles.rollingFriction[i]);
-  }
-  GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
-                                           const contact::ContactResponse& res) {
-    storeWall(list, c, g, res);
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/types.hpp"
 #include "lab/moduli.hpp"
@@ -36,6 +37,49 @@ double slope(const std::vector<double>& x, const std::vector<double>& y, std::si
   return sxx > 0.0 ? sxy / sxx : 0.0;
 }
 
+namespace {
+
+// Means of the friction angle, the stress ratio and the void ratio over eps1 >= m.residualFrom
+// (the critical-state window), written into m.
+void residualMeans(const TriaxialCurves& c, const std::vector<double>& phi, const std::vector<double>& ratio,
+                   MacroParameters& m) {
+  double sumPhi = 0.0, sumRatio = 0.0, sumE = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < c.eps1.size(); ++i) {
+    if (c.eps1[i] < m.residualFrom) continue;
+    sumPhi += phi[i];
+    sumRatio += ratio[i];
+    sumE += c.voidRatio.empty() ? 0.0 : c.voidRatio[i];
+    ++count;
+  }
+  if (count > 0) {
+    m.phiResDeg = sumPhi / count;
+    m.csStressRatio = sumRatio / count;
+    m.csVoidRatio = sumE / count;
+  }
+}
+
+// Largest dilatancy angle over centred windows of +-halfWindow in eps1: the least-squares slope of
+// eps_v on eps1 in each window (at least 3 points) is turned into an angle by psiOf, which returns
+// nothing where the slope has no angle.
+template <class PsiOf>
+void maxDilatancy(const TriaxialCurves& c, double halfWindow, PsiOf psiOf, MacroParameters& m) {
+  const std::size_t n = c.eps1.size();
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (lo < n && c.eps1[lo] < c.eps1[i] - halfWindow) ++lo;
+    while (hi < n && c.eps1[hi] <= c.eps1[i] + halfWindow) ++hi;
+    if (hi - lo < 3) continue;
+    const std::optional<double> psi = psiOf(slope(c.eps1, c.epsV, lo, hi));
+    if (psi && (!m.psiMaxDeg || *psi > *m.psiMaxDeg)) {
+      m.psiMaxDeg = *psi;
+      m.eps1AtPsiMax = c.eps1[i];
+    }
+  }
+}
+
+}  // namespace
+
 MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
   MacroParameters m;
   const std::size_t n = c.eps1.size();
@@ -51,39 +95,20 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
   m.eps1AtPeak = c.eps1[peak];
   m.qPeak = *std::max_element(q.begin(), q.end());
 
-  const double epsEnd = c.eps1.back();
-  m.residualFrom = (1.0 - s.residualFraction) * epsEnd;
-  double sumPhi = 0.0, sumRatio = 0.0, sumE = 0.0;
-  int count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (c.eps1[i] < m.residualFrom) continue;
-    sumPhi += phi[i];
-    sumRatio += p[i] > 0.0 ? q[i] / p[i] : 0.0;
-    sumE += c.voidRatio.empty() ? 0.0 : c.voidRatio[i];
-    ++count;
-  }
-  if (count > 0) {
-    m.phiResDeg = sumPhi / count;
-    m.csStressRatio = sumRatio / count;
-    m.csVoidRatio = sumE / count;
-  }
+  std::vector<double> ratio(n);
+  for (std::size_t i = 0; i < n; ++i) ratio[i] = p[i] > 0.0 ? q[i] / p[i] : 0.0;
+  m.residualFrom = (1.0 - s.residualFraction) * c.eps1.back();
+  residualMeans(c, phi, ratio, m);
 
-  // Dilatancy: centred least-squares slope of eps_v on eps1.
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
-    while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
-    if (hi - lo < 3) continue;
-    const double rate = slope(c.eps1, c.epsV, lo, hi);
-    // sin psi = -r/(2 - r) is only defined while the lateral strain rate is extensional or small
-    // (r < 2); a sudden collapse (eps_v growing faster than 2 eps1) has no dilatancy angle.
-    if (rate >= 1.0) continue;
-    const double psi = dilatancyAngleDeg(rate);
-    if (!m.psiMaxDeg || psi > *m.psiMaxDeg) {
-      m.psiMaxDeg = psi;
-      m.eps1AtPsiMax = c.eps1[i];
-    }
-  }
+  // Dilatancy: sin psi = -r/(2 - r) of the slope r = d eps_v / d eps1 is only defined while the
+  // lateral strain rate is extensional or small (r < 2); a sudden collapse (eps_v growing faster
+  // than the axial strain) has no dilatancy angle.
+  maxDilatancy(c, s.dilatancyHalfWindow,
+               [](double rate) -> std::optional<double> {
+                 if (rate >= 1.0) return std::nullopt;
+                 return dilatancyAngleDeg(rate);
+               },
+               m);
   m.e50 = secantE50(c.eps1, q);
   return m;
 }
@@ -102,31 +127,10 @@ MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSett
   m.eps1AtPeak = c.eps1[peak];
   m.qPeak = c.shearStress[peak];
   m.residualFrom = (1.0 - s.residualFraction) * c.eps1.back();
-  double sumPhi = 0.0, sumRatio = 0.0, sumE = 0.0;
-  int count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (c.eps1[i] < m.residualFrom) continue;
-    sumPhi += phi[i];
-    sumRatio += ratio[i];
-    sumE += c.voidRatio.empty() ? 0.0 : c.voidRatio[i];
-    ++count;
-  }
-  if (count > 0) {
-    m.phiResDeg = sumPhi / count;
-    m.csStressRatio = sumRatio / count;
-    m.csVoidRatio = sumE / count;
-  }
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    while (lo < n && c.eps1[lo] < c.eps1[i] - s.dilatancyHalfWindow) ++lo;
-    while (hi < n && c.eps1[hi] <= c.eps1[i] + s.dilatancyHalfWindow) ++hi;
-    if (hi - lo < 3) continue;
-    const double psi = radToDeg(std::atan(-slope(c.eps1, c.epsV, lo, hi)));
-    if (!m.psiMaxDeg || psi > *m.psiMaxDeg) {
-      m.psiMaxDeg = psi;
-      m.eps1AtPsiMax = c.eps1[i];
-    }
-  }
+  residualMeans(c, phi, ratio, m);
+  // Simple shear: tan psi = -d eps_v / d gamma.
+  maxDilatancy(c, s.dilatancyHalfWindow,
+               [](double rate) -> std::optional<double> { return radToDeg(std::atan(-rate)); }, m);
   std::size_t end = 0;
   while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
   end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));

@@ -7,6 +7,32 @@ import pytest
 GRAINLAB = os.environ.get("GRAINLAB_BIN", os.path.join(os.path.dirname(__file__), "..", "..", "build", "grainlab"))
 DATA = os.path.join(os.path.dirname(__file__), "..", "data")
 
+# A 100-sphere triaxial test to 0.3 % axial strain on one thread (about a second): the base of the
+# hostile-input tests and the fuzzer, which change one thing at a time.
+TINY_CONFIG = """\
+[sample]
+n_particles = 100
+grading = { type = "uniform", d_min = 4.0e-3, d_max = 6.0e-3 }
+e0 = 0.7
+seed = 3
+prep_friction_deg = 0.0
+
+[test]
+type = "triaxial"
+confining_pressure = 100.0e3
+axial_strain_rate = 1.0
+final_axial_strain = 0.003
+
+[solver]
+threads = 1
+
+[output]
+record_every_strain = 0.0005
+vtk_every_strain = 0
+checkpoint_every = 0.001
+plots = false
+"""
+
 
 @pytest.fixture
 def grainlab():

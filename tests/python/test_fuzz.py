@@ -15,35 +15,12 @@ import subprocess
 
 import pytest
 
-from conftest import GRAINLAB
+from conftest import GRAINLAB, TINY_CONFIG as BASE
 
 SCALE = max(1, int(os.environ.get("GRAINLAB_FUZZ_SCALE", "1")))
 SEED = int(os.environ.get("GRAINLAB_FUZZ_SEED", "16"))
 TIMEOUT = 20  # [s] per invocation: more is a hang
 
-BASE = """\
-[sample]
-n_particles = 100
-grading = { type = "uniform", d_min = 4.0e-3, d_max = 6.0e-3 }
-e0 = 0.7
-seed = 3
-prep_friction_deg = 0.0
-
-[test]
-type = "triaxial"
-confining_pressure = 100.0e3
-axial_strain_rate = 1.0
-final_axial_strain = 0.003
-
-[solver]
-threads = 1
-
-[output]
-record_every_strain = 0.0005
-vtk_every_strain = 0
-checkpoint_every = 0.001
-plots = false
-"""
 
 NUMBER_KEYS = [
     "sample.density", "sample.e0", "sample.e0_tolerance", "sample.initial_void_ratio", "sample.prep_stiffness_factor",

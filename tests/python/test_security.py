@@ -14,31 +14,8 @@ import time
 
 import pytest
 
-from conftest import GRAINLAB
+from conftest import GRAINLAB, TINY_CONFIG as TINY
 
-TINY = """\
-[sample]
-n_particles = 100
-grading = { type = "uniform", d_min = 4.0e-3, d_max = 6.0e-3 }
-e0 = 0.7
-seed = 3
-prep_friction_deg = 0.0
-
-[test]
-type = "triaxial"
-confining_pressure = 100.0e3
-axial_strain_rate = 1.0
-final_axial_strain = 0.003
-
-[solver]
-threads = 1
-
-[output]
-record_every_strain = 0.0005
-vtk_every_strain = 0
-checkpoint_every = 0.001
-plots = false
-"""
 
 
 def run(args, cwd=None, timeout=300, **kw):

@@ -173,15 +173,7 @@ TEST(EllipsoidEngine, NoMissedContactsAgainstBruteForce) {
 namespace {
 
 lab::RunConfig latticeConfig(int n, const std::string& shape) {
-  lab::RunConfig c;
-  c.sample.nParticles = n * n * n;
-  c.sample.method = "lattice";
-  c.sample.grading.type = "uniform";
-  c.sample.grading.dMin = c.sample.grading.dMax = 2e-3;
-  c.sample.prepRampSteps = 2000;
-  c.test.boundary = "periodic";
-  c.test.type = "isotropic";
-  c.contact.kn = 25.0 * 100e3 * 2e-3;  // [O]'s stiffness number 25 at 100 kPa
+  lab::RunConfig c = scenes::simpleCubicLattice(n, 25.0);  // [O]'s stiffness number 25 at 100 kPa
   c.contact.poisson = 1.0;
   if (shape == "ellipsoid") {
     c.sample.shape.type = "ellipsoid";

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/simulation.hpp"
+#include "lab/run_config.hpp"
 
 namespace grainlab::scenes {
 
@@ -22,6 +23,22 @@ inline Simulation emptyScene(double halfSide = 1.0, double frictionDeg = 30.0) {
   sim.model.eta = 1.0;
   sim.localDamping = 0.0;
   return sim;
+}
+
+// n^3 equal spheres (d = 2 mm) on a simple cubic lattice in the periodic cell, loaded isotropically
+// at the default 100 kPa with the constant normal stiffness kn = kappa p d of [O] (kappa: the
+// stiffness number).
+inline lab::RunConfig simpleCubicLattice(int n, double stiffnessNumber) {
+  lab::RunConfig c;
+  c.sample.nParticles = n * n * n;
+  c.sample.method = "lattice";
+  c.sample.grading.type = "uniform";
+  c.sample.grading.dMin = c.sample.grading.dMax = 2e-3;
+  c.sample.prepRampSteps = 2000;
+  c.test.boundary = "periodic";
+  c.test.type = "isotropic";
+  c.contact.kn = stiffnessNumber * c.test.confiningPressure * 2e-3;  // [N/m]
+  return c;
 }
 
 }  // namespace grainlab::scenes

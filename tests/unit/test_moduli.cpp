@@ -8,6 +8,7 @@
 
 #include "lab/moduli.hpp"
 #include "lab/protocols.hpp"
+#include "test_helpers.hpp"
 
 using namespace grainlab;
 
@@ -109,22 +110,6 @@ TEST(Moduli, UnloadReloadSecantOfASyntheticLoop) {
   EXPECT_FALSE(open[0].eur.has_value());
 }
 
-namespace {
-
-lab::RunConfig latticeConfig(int n, double stiffnessNumber) {
-  lab::RunConfig c;
-  c.sample.nParticles = n * n * n;
-  c.sample.method = "lattice";
-  c.sample.grading.type = "uniform";
-  c.sample.grading.dMin = c.sample.grading.dMax = 2e-3;
-  c.sample.prepRampSteps = 2000;
-  c.test.boundary = "periodic";
-  c.test.type = "isotropic";
-  c.contact.kn = stiffnessNumber * c.test.confiningPressure * 2e-3;  // kappa = kn/(p d) [N/m]
-  return c;
-}
-
-}  // namespace
 
 // Simple cubic lattice of equal spheres, loaded isotropically, probed along a lattice axis (z).
 // Every contact lies along x, y or z. An axial strain d_eps shortens each z contact by l d_eps
@@ -136,7 +121,7 @@ lab::RunConfig latticeConfig(int n, double stiffnessNumber) {
 // A law with twice or half kn fails.
 TEST(Moduli, ProbeOfASimpleCubicLatticeGivesKnOverSpacing) {
   const int n = 4;
-  const lab::RunConfig config = latticeConfig(n, 1e4);
+  const lab::RunConfig config = scenes::simpleCubicLattice(n, 1e4);
   lab::Laboratory lab(config);
   lab.prepare();
   const Simulation before = lab.simulation();
@@ -163,7 +148,7 @@ TEST(Moduli, ProbeOfASimpleCubicLatticeGivesKnOverSpacing) {
 // nu = delta/l = p l/kn (delta = F/kn the overlap, F = p l^2). 4 % here, against 0 for the stiff case.
 TEST(Moduli, ProbeOfASoftLatticeShowsTheInitialStressTerm) {
   const int n = 4;
-  const lab::RunConfig config = latticeConfig(n, 25.0);
+  const lab::RunConfig config = scenes::simpleCubicLattice(n, 25.0);
   lab::Laboratory lab(config);
   lab.prepare();
   const lab::ModulusProbe probe = lab.probeModuli();
@@ -175,7 +160,7 @@ TEST(Moduli, ProbeOfASoftLatticeShowsTheInitialStressTerm) {
 
 // No probe asked for: nothing measured, and it says so.
 TEST(Moduli, NoProbeIsNullNotZero) {
-  lab::RunConfig config = latticeConfig(4, 1e4);
+  lab::RunConfig config = scenes::simpleCubicLattice(4, 1e4);
   config.test.probeStrain = 0.0;
   lab::Laboratory lab(config);
   lab.prepare();
