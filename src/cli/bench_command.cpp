@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/thread_count.hpp"
 #include "core/errors.hpp"
 #include "io/config.hpp"
 #include "io/input_file.hpp"
@@ -116,6 +117,9 @@ int runBench(const BenchOptions& opt) {
   }
   lab::configureSolver(config, sim);
   if (scene != "lattice") lab::holdIsotropicStress(sim, config.test.confiningPressure);
+  // A benchmark times the threads it is asked for, but says when other processes share the cores.
+  const ThreadChoice choice = chooseThreads(opt.threads, /*adapt=*/false);
+  if (!choice.warning.empty()) fmt::print(stderr, "{}\n", choice.warning);
   omp_set_num_threads(opt.threads);
   for (int i = 0; i < 200; ++i) sim.step();  // rebuild contacts and their history
   const long buildsBefore = sim.broadPhase.builds;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -12,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "cli/thread_count.hpp"
 #include "core/errors.hpp"
 #include "core/state_io.hpp"
 #include "io/checkpoint_file.hpp"
@@ -430,12 +432,20 @@ int inFolder(io::RunFolder& folder, const std::function<int()>& body) {
 
 }  // namespace
 
+// solver.threads, or fewer on a machine whose cores other processes keep busy (cli/thread_count.hpp);
+// the summary and the resolved config keep the requested count: results do not depend on it.
+static void useThreads(int requested) {
+  const ThreadChoice choice = chooseThreads(requested);
+  if (!choice.warning.empty()) std::fprintf(stderr, "%s\n", choice.warning.c_str());
+  omp_set_num_threads(choice.threads);
+}
+
 int runLab(const RunOptions& opt) { return runResolved(resolveConfig(opt), opt, {}); }
 
 int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::ProgressFn& observer) {
   // Every input file is read and checked before the results folder is touched.
   std::optional<Simulation> packed = loadInputFiles(config);
-  omp_set_num_threads(config.solver.threads);
+  useThreads(config.solver.threads);
   io::RunFolder folder = io::RunFolder::forRun(config.output.dir);
   return inFolder(folder, [&] {
     const fs::path dir = folder.work();
@@ -545,7 +555,7 @@ int resumeLab(const ResumeOptions& opt) {
   const lab::RunConfig config = resolveConfig(resolved);
   const io::Checkpoint checkpoint = io::readCheckpointFile(stateFile);
   io::checkCheckpointBelongs(checkpoint, stateFile, config, opt.allowOlderVersion);
-  omp_set_num_threads(config.solver.threads);
+  useThreads(config.solver.threads);
   const json& record = checkpoint.record;
   // Checkpoints of runs before the micromechanics snapshots have no list: the run numbers from 0.
   RunSession session(config, folder, opt.quiet, record["summary"], record["wall_seconds"].get<double>(),

@@ -78,7 +78,8 @@ def test_periodic_results_do_not_depend_on_threads(grainlab, data_dir, tmp_path)
 
 def test_too_small_cell_is_refused(grainlab, data_dir, tmp_path):
     proc = grainlab("run", os.path.join(data_dir, "small-triaxial.toml"), "--out", str(tmp_path / "x"),
-                    "--set", "test.boundary=\"periodic\"", "--set", "sample.n_particles=12", "--quiet")
+                    "--set", "test.boundary=\"periodic\"", "--set", "sample.n_particles=12", "--quiet",
+                    "--threads", "1")  # one thread: no warning about busy cores can join the one line
     assert proc.returncode == 2
     assert "periodic cell" in proc.stderr and "n_particles" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
