@@ -1,8 +1,13 @@
 #!/usr/bin/env python3
 """The e0 study of issue 13: a loose and a dense [W] x10 sample sheared to 20 % axial strain.
 
-    /usr/bin/python3 tools/e0_study.py run    [--runs DIR] [--exe build/grainlab] [--jobs 2] [--seeds 1,2]
-    /usr/bin/python3 tools/e0_study.py report [--runs DIR] [--docs docs/results]
+    /usr/bin/python3 tools/e0_study.py run    [--runs DIR] [--exe build/grainlab] [--jobs 2] [--seeds 1,2] [--sand w|calibrated]
+    /usr/bin/python3 tools/e0_study.py report [--runs DIR] [--docs docs/results] [--sand w|calibrated]
+
+--sand calibrated runs the same study with the Karlsruhe-calibrated sand (preset
+karlsruhe-calibrated, issue 13 section 3) at p = 100 kPa: e0 = 0.60 and 0.80 by the friction search
+with the contact moments on; its report goes to docs/results/e0-study-calibrated-table.md and
+docs/results/e0-study-calibrated/.
 
 `run` shears every case of CASES for every seed from the `w-base` preset (2000 spheres, [W]
 parameters, p = 100 kPa), one thread per run, --jobs runs at a time, into DIR/<case>-s<seed>; a
@@ -34,11 +39,27 @@ CASES = [
     ("loose80", "e0 = 0.80, compaction with moments", ["sample.e0=0.80", 'sample.method="compaction"']),
 ]
 COMMON = ["output.plots=false", "output.vtk_every_strain=0", "output.checkpoint_every=0.05"]
+# The Karlsruhe-calibrated sand (its preset compacts without friction; here the friction search
+# reaches each e0), at the study's 100 kPa.
+CALIBRATED_CASES = [
+    ("dense", "calibrated, e0 = 0.60", ["sample.e0=0.60", 'sample.method="compaction"', 'sample.prep_friction_deg="auto"',
+                                        "test.confining_pressure=100.0e3"]),
+    ("loose80", "calibrated, e0 = 0.80", ["sample.e0=0.80", 'sample.method="compaction"',
+                                          'sample.prep_friction_deg="auto"', "test.confining_pressure=100.0e3"]),
+]
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def case_dirs(runs, seeds):
+def study(args):
+    """(preset, cases, name of the report) of the --sand chosen."""
+    if args.sand == "calibrated":
+        return os.path.join(ROOT, "presets", "karlsruhe-calibrated.toml"), CALIBRATED_CASES, "e0-study-calibrated"
+    return "preset:w-base", CASES, "e0-study"
+
+
+def case_dirs(runs, seeds, cases=CASES):
     return [(case, label, seed, os.path.join(runs, f"{case}-s{seed}"), sets)
-            for case, label, sets in CASES for seed in seeds]
+            for case, label, sets in cases for seed in seeds]
 
 
 def completed(folder):
@@ -51,13 +72,14 @@ def completed(folder):
 
 def run(args):
     seeds = [int(s) for s in args.seeds.split(",")]
-    todo = [c for c in case_dirs(args.runs, seeds) if not completed(c[3])]
+    preset, cases, _ = study(args)
+    todo = [c for c in case_dirs(args.runs, seeds, cases) if not completed(c[3])]
     os.makedirs(args.runs, exist_ok=True)
     running = []
     while todo or running:
         while todo and len(running) < args.jobs:
             case, _, seed, folder, sets = todo.pop(0)
-            cmd = ["nice", args.exe, "run", "preset:w-base", "--out", folder, "--threads", "1", "--quiet",
+            cmd = ["nice", args.exe, "run", preset, "--out", folder, "--threads", "1", "--quiet",
                    "--set", f"sample.seed={seed}"]
             for s in sets + COMMON:
                 cmd += ["--set", s]
@@ -99,14 +121,15 @@ def fmt(v, spec):
 
 def report(args):
     found = []
-    for case, label, seed, folder, _ in case_dirs(args.runs, [1, 2, 3, 4]):
+    _, cases, name = study(args)
+    for case, label, seed, folder, _ in case_dirs(args.runs, [1, 2, 3, 4], cases):
         if completed(folder):
             with open(os.path.join(folder, "summary.json")) as f:
                 found.append((case, label, seed, folder, json.load(f), read_series(folder)))
     if not found:
         print("no completed runs in", args.runs, file=sys.stderr)
         return 1
-    figdir = os.path.join(args.docs, "e0-study")
+    figdir = os.path.join(args.docs, name)
     os.makedirs(figdir, exist_ok=True)
     colours = {"loose": "tab:blue", "loose80": "tab:green", "dense": "tab:red"}
     styles = ["-", "--", ":", "-."]
@@ -156,7 +179,7 @@ def report(args):
                 de = abs(sm["cs_void_ratio"] - b_["cs_void_ratio"])
                 lines.append(f"| {tag} vs dense: same end state, q/p within 0.1 | {dq:.3f} → {'met' if dq <= 0.1 else 'missed'} |")
                 lines.append(f"| {tag} vs dense: same end state, e within 0.03 | {de:.3f} → {'met' if de <= 0.03 else 'missed'} |")
-    path = os.path.join(args.docs, "e0-study-table.md")
+    path = os.path.join(args.docs, f"{name}-table.md")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
@@ -171,6 +194,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seeds", default="1,2")
     ap.add_argument("--docs", default="docs/results")
+    ap.add_argument("--sand", choices=["w", "calibrated"], default="w")
     args = ap.parse_args()
     return run(args) if args.command == "run" else report(args)
 
