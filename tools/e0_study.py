@@ -133,7 +133,7 @@ def report(args):
     os.makedirs(figdir, exist_ok=True)
     colours = {"loose": "tab:blue", "loose80": "tab:green", "dense": "tab:red"}
     styles = ["-", "--", ":", "-."]
-    for name, key, scale, ylabel in [("q.png", "q", 1e-3, "deviator q [kPa]"),
+    for png, key, scale, ylabel in [("q.png", "q", 1e-3, "deviator q [kPa]"),
                                      ("epsv.png", "eps_v", 100.0, "volumetric strain eps_v [%] (contraction +)"),
                                      ("e.png", "e", 1.0, "void ratio e")]:
         fig, ax = plt.subplots(figsize=(6.4, 4.2))
@@ -145,7 +145,7 @@ def report(args):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(os.path.join(figdir, name), dpi=90)
+        fig.savefig(os.path.join(figdir, png), dpi=90)
         plt.close(fig)
     lines = ["| case | seed | e0 | Z | Z_mech | house of cards | E0 [MPa] | ν0 | E50 [MPa] | φp [°] | φres [°] | "
              "φp − φres [°] | ψmax [°] | εv at 20 % [%] | q/p end | e end | σ3 dev. max [%] | wall [s] |",
