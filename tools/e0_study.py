@@ -20,9 +20,9 @@ import csv
 import json
 import math
 import os
-import subprocess
 import sys
-import time
+
+from study_runs import completed, run_cases  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -62,38 +62,12 @@ def case_dirs(runs, seeds, cases=CASES):
             for case, label, sets in cases for seed in seeds]
 
 
-def completed(folder):
-    try:
-        with open(os.path.join(folder, "summary.json")) as f:
-            return json.load(f).get("status") == "completed"
-    except (OSError, ValueError):
-        return False
-
-
 def run(args):
     seeds = [int(s) for s in args.seeds.split(",")]
     preset, cases, _ = study(args)
-    todo = [c for c in case_dirs(args.runs, seeds, cases) if not completed(c[3])]
-    os.makedirs(args.runs, exist_ok=True)
-    running = []
-    while todo or running:
-        while todo and len(running) < args.jobs:
-            case, _, seed, folder, sets = todo.pop(0)
-            cmd = ["nice", args.exe, "run", preset, "--out", folder, "--threads", "1", "--quiet",
-                   "--set", f"sample.seed={seed}"]
-            for s in sets + COMMON:
-                cmd += ["--set", s]
-            log = open(folder + ".log", "w")
-            running.append((subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT), folder, log, time.time()))
-            print("started", folder, flush=True)
-        time.sleep(5)
-        for item in list(running):
-            proc, folder, log, t0 = item
-            if proc.poll() is not None:
-                log.close()
-                running.remove(item)
-                print(f"{folder}: exit {proc.returncode} after {time.time() - t0:.0f} s", flush=True)
-    return 0
+    return run_cases(args.exe, preset, [(folder, [f"sample.seed={seed}"] + sets + COMMON)
+                                        for _, _, seed, folder, sets in case_dirs(args.runs, seeds, cases)],
+                     args.jobs, nice=True)
 
 
 def number(text):

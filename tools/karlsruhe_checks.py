@@ -15,9 +15,9 @@ import argparse
 import csv
 import json
 import os
-import subprocess
 import sys
-import time
+
+from study_runs import completed, run_cases  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -39,33 +39,8 @@ COMMON = ["output.plots=false", "output.vtk_every_strain=0"]
 LAB = {"phi_peak_deg": 43.7, "psi_max_deg": 28.5, "E50_MPa": 104.0}
 
 
-def completed(folder):
-    try:
-        with open(os.path.join(folder, "summary.json")) as f:
-            return json.load(f).get("status") == "completed"
-    except (OSError, ValueError):
-        return False
-
-
 def run(a):
-    os.makedirs(a.runs, exist_ok=True)
-    todo = [(c, sets) for c, _, sets in CASES if not completed(os.path.join(a.runs, c))]
-    running = []
-    while todo or running:
-        while todo and len(running) < a.jobs:
-            case, sets = todo.pop(0)
-            argv = [a.exe, "run", PRESET, "--out", os.path.join(a.runs, case), "--quiet", "--threads", "1"]
-            for s in COMMON + sets:
-                argv += ["--set", s]
-            log = open(os.path.join(a.runs, case + ".log"), "w")
-            running.append((case, subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT), time.time()))
-        time.sleep(2)
-        for item in list(running):
-            case, proc, t0 = item
-            if proc.poll() is not None:
-                running.remove(item)
-                print(f"{case}: exit {proc.returncode} after {time.time() - t0:.0f} s", flush=True)
-    return 0
+    return run_cases(a.exe, PRESET, [(os.path.join(a.runs, c), COMMON + sets) for c, _, sets in CASES], a.jobs)
 
 
 def series(folder):

@@ -1,0 +1,41 @@
+"""What the study tools (e0_study.py, karlsruhe_checks.py, wall_spheroids.py) share: whether a run
+folder holds a completed run, and a queue that runs `grainlab run` cases a few at a time."""
+import json
+import os
+import subprocess
+import time
+
+
+def completed(folder):
+    """True when folder/summary.json says the run completed."""
+    try:
+        with open(os.path.join(folder, "summary.json")) as f:
+            return json.load(f).get("status") == "completed"
+    except (OSError, ValueError):
+        return False
+
+
+def run_cases(exe, preset, cases, jobs, nice=False):
+    """Runs `exe run preset --out FOLDER --quiet --threads 1 --set ...` for every (folder, sets) of
+    `cases` whose folder is not completed, `jobs` at a time, each logging to FOLDER.log; prints each
+    exit status. Every process gets an argument vector."""
+    todo = [(folder, sets) for folder, sets in cases if not completed(folder)]
+    running = []
+    while todo or running:
+        while todo and len(running) < jobs:
+            folder, sets = todo.pop(0)
+            os.makedirs(os.path.dirname(folder) or ".", exist_ok=True)
+            argv = (["nice"] if nice else []) + [exe, "run", preset, "--out", folder, "--quiet", "--threads", "1"]
+            for s in sets:
+                argv += ["--set", s]
+            log = open(folder + ".log", "w")
+            running.append((folder, subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT), log, time.time()))
+            print("started", folder, flush=True)
+        time.sleep(2)
+        for item in list(running):
+            folder, proc, log, t0 = item
+            if proc.poll() is not None:
+                log.close()
+                running.remove(item)
+                print(f"{folder}: exit {proc.returncode} after {time.time() - t0:.0f} s", flush=True)
+    return 0
