@@ -44,27 +44,12 @@ parser.add_argument('--periodic', action='store_true')
 args = parser.parse_args(sys.argv[1:])
 
 if args.periodic:
-    from yade.minieigenHP import Matrix3, Vector3  # Debian yade 2023: no separate minieigen
-    from yade.wrapper import (Bo1_Sphere_Aabb, ForceResetter, Ig2_Sphere_Sphere_ScGeom6D, InsertionSortCollider,
-                              InteractionLoop, Ip2_CohFrictMat_CohFrictMat_CohFrictPhys,
-                              Law2_ScGeom6D_CohFrictPhys_CohesionMoment, NewtonIntegrator, PeriTriaxController)
-    import packing_file
-    cellRows, spheres = packing_file.read_periodic_packing(args.packing)
-    O.periodic = True
-    O.cell.hSize = Matrix3(*[v for row in cellRows for v in row])
-    material = yade_scene.sphere_material(moments=True)
-    for r, x, y, z in spheres:
-        O.bodies.append(utils.sphere((x, y, z), r, material=material))
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb()]),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D()], [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
-                        [Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True,
-                                                                   always_use_moment_law=True)]),
-        PeriTriaxController(goal=Vector3(-args.pressure, -args.pressure, -args.pressure), stressMask=7,
-                            maxStrainRate=Vector3(1.0, 1.0, 1.0), maxUnbalanced=1e-3),
-        NewtonIntegrator(damping=yade_scene.DAMPING, gravity=(0, 0, 0)),
-    ]
+    from yade.minieigenHP import Vector3  # Debian yade 2023: no separate minieigen
+    from yade.wrapper import PeriTriaxController
+    spheres = yade_scene.build_periodic(args.packing)
+    O.engines = yade_scene.periodic_engines(PeriTriaxController(
+        goal=Vector3(-args.pressure, -args.pressure, -args.pressure), stressMask=7,
+        maxStrainRate=Vector3(1.0, 1.0, 1.0), maxUnbalanced=1e-3))
     firstSphere = 0
 else:
     planes, spheres = yade_scene.read_packing(args.packing)

@@ -30,11 +30,8 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: the script's folder
 from yade import O, utils  # noqa: E402
-from yade.wrapper import (Bo1_Sphere_Aabb, ForceResetter, Ig2_Sphere_Sphere_ScGeom6D,  # noqa: E402
-                          InsertionSortCollider, InteractionLoop, Ip2_CohFrictMat_CohFrictMat_CohFrictPhys,
-                          Law2_ScGeom6D_CohFrictPhys_CohesionMoment, NewtonIntegrator, PeriTriaxController)
+from yade.wrapper import PeriTriaxController  # noqa: E402
 from yade.minieigenHP import Matrix3, Vector3  # noqa: E402 (Debian yade 2023: no separate minieigen)
-import packing_file  # noqa: E402
 import yade_scene  # noqa: E402
 
 parser = argparse.ArgumentParser(prog='yade -n -x yade_periodic.py')
@@ -48,24 +45,12 @@ parser.add_argument('--record-every', type=float, default=5e-4, help='axial stra
 parser.add_argument('--dt-factor', type=float, default=0.5, help='dt = factor * PWaveTimeStep()')
 args = parser.parse_args(sys.argv[1:])
 
-cellRows, spheres = packing_file.read_periodic_packing(args.packing)
-O.periodic = True
-O.cell.hSize = Matrix3(*[v for row in cellRows for v in row])
-material = yade_scene.sphere_material(moments=True)
-for r, x, y, z in spheres:
-    O.bodies.append(utils.sphere((x, y, z), r, material=material))
+spheres = yade_scene.build_periodic(args.packing)
 nSpheres = len(spheres)
 
 ctrl = PeriTriaxController(goal=Vector3(-args.pressure, -args.pressure, -args.pressure), stressMask=7,
                            maxStrainRate=Vector3(1.0, 1.0, 1.0), maxUnbalanced=1e-3, label='ctrl')
-O.engines = [
-    ForceResetter(),
-    InsertionSortCollider([Bo1_Sphere_Aabb()]),
-    InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D()], [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
-                    [Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=True)]),
-    ctrl,
-    NewtonIntegrator(damping=yade_scene.DAMPING, gravity=(0, 0, 0)),
-]
+O.engines = yade_scene.periodic_engines(ctrl)
 O.dt = args.dt_factor * utils.PWaveTimeStep()
 
 

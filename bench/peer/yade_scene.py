@@ -1,5 +1,5 @@
 # -*- coding: utf-8 -*-
-"""The YADE scene shared by the peer scripts (yade_triaxial.py, yade_bench.py): the [W] parameters,
+"""The YADE scene shared by the peer scripts (yade_triaxial.py, yade_bench.py, yade_periodic.py): the [W] parameters,
 a grainlab packing file read back (format 2 or 1, by packing_file.py), the two CohFrictMat
 materials, six Box walls on the packing's planes (ids 0..5 = xlo, xhi, ylo, yhi, zlo, zhi,
 TriaxialStressController's numbering), the spheres, and the engine list. Imported by those scripts under `yade -x`, which puts their folder
@@ -71,3 +71,31 @@ def engines(controller, extra=(), law_label=None):
         *extra,
         NewtonIntegrator(damping=DAMPING, gravity=(0, 0, 0)),
     ]
+
+
+def build_periodic(path):
+    """A periodic cell from a grainlab packing of a cell (O.cell.hSize from the file) and its spheres
+    with the [W] material; returns the spheres [(r, x, y, z)]."""
+    from yade.minieigenHP import Matrix3  # Debian yade 2023: no separate minieigen
+    import packing_file
+    cell_rows, spheres = packing_file.read_periodic_packing(path)
+    O.periodic = True
+    O.cell.hSize = Matrix3(*[v for row in cell_rows for v in row])
+    material = sphere_material(moments=True)
+    for r, x, y, z in spheres:
+        O.bodies.append(utils.sphere((x, y, z), r, material=material))
+    return spheres
+
+
+def periodic_engines(controller):
+    """The engine list of a periodic cell: collider, the CohFrictMat law with incremental moments,
+    the cell's controller (PeriTriaxController), then Newton with the [W] damping and no gravity."""
+    return [
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb()]),
+        InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D()], [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
+                        [Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=True)]),
+        controller,
+        NewtonIntegrator(damping=DAMPING, gravity=(0, 0, 0)),
+    ]
+
