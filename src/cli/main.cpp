@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   runCmd->add_option("--out", run.outDir, "results folder (overrides output.dir)");
   runCmd->add_option("--set", run.overrides, "override a config key: KEY=VALUE (TOML value)")
       ->allow_extra_args(false);
-  runCmd->add_option("--threads", run.threads, "OpenMP threads (overrides solver.threads)")
+  runCmd->add_option("--threads", run.threads, "OpenMP threads (overrides solver.threads); fewer when other processes keep the cores busy (a warning says so; GRAINLAB_KEEP_THREADS=1 keeps them)")
       ->check(CLI::PositiveNumber);
   runCmd->add_flag("--quiet", run.quiet, "no progress output");
 
