@@ -337,6 +337,8 @@ std::vector<std::string> Laboratory::shearStageNames() {
 
 ShearResult Laboratory::continueShear() {
   ShearState& st = shear_;
+  // The test's servo cap (test.servo_max_speed), set here so that a resumed test has it too.
+  sim_.servo.maxSpeed = config_.test.servoMaxSpeed;
   Pipeline pipeline(sim_);
   buildShearPipeline(pipeline);
   pipeline.run();

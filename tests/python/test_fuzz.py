@@ -27,7 +27,7 @@ NUMBER_KEYS = [
     "sample.prep_damping", "sample.prep_friction_deg", "contact.young", "contact.poisson", "contact.friction_deg",
     "contact.beta", "contact.eta", "contact.wall_friction_deg", "test.confining_pressure", "test.axial_strain_rate",
     "test.final_axial_strain", "solver.damping", "solver.dt_factor", "solver.dt", "solver.unbalanced_tolerance",
-    "solver.stress_tolerance", "solver.servo_gain", "solver.servo_integral_steps", "solver.servo_max_speed",
+    "solver.stress_tolerance", "solver.servo_gain", "solver.servo_integral_steps", "solver.servo_max_speed", "test.servo_max_speed",
     "solver.skin_fraction", "output.record_every_strain", "output.checkpoint_every", "output.vtk_every_strain",
     "output.band_factor",
 ]
