@@ -306,17 +306,24 @@ class RunSession {
       summary_["Eur_method"] = "not measured (no test.unload_reload_at)";
       return;
     }
-    json eur = json::array(), at = json::array();
+    json eur = json::array(), at = json::array(), relaxed = json::array();
     for (const auto& l : loops) {
       eur.push_back(l.eur ? json(finite(*l.eur / 1e6, "Eur_MPa")) : json(nullptr));
       at.push_back(l.eps1Reversal);
+      relaxed.push_back(l.restRelaxation ? json(finite(*l.restRelaxation, "Eur_rest_q_relaxation")) : json(nullptr));
     }
     summary_["Eur_MPa"] = eur;
     summary_["Eur_at_eps1"] = at;
+    // The fraction of q lost at constant strain during the rest before each unload (null: no rest).
+    summary_["Eur_rest_q_relaxation"] = relaxed;
     summary_["Eur_method"] = fmt::format(
         "per loop: secant of the reload branch, from the turning point (unloaded to q = {} q at reversal) to where "
-        "the reload regains the reversal strain; platens at {} of the loading speed",
-        config_.test.unloadToQFraction, lab::Laboratory::kLoopSpeedFactor);
+        "the reload regains the reversal strain; platens at {} of the loading speed{}",
+        config_.test.unloadToQFraction, lab::Laboratory::kLoopSpeedFactor,
+        config_.test.loopRest ? fmt::format("; before each unload the platens stood still until the unbalanced-force "
+                                            "ratio was below {} (q at reversal: after that rest)",
+                                            lab::Laboratory::kProbeUnbalanced)
+                              : std::string());
   }
 
   // A failed (or interrupted) run still leaves a summary saying so (and nothing non-finite).

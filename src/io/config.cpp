@@ -578,6 +578,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                "must be in [0, 1) (unbalanced-force ratio above which the platens slow down; 0: off)");
   c.test.servoMaxSpeed = t.number("servo_max_speed", c.test.servoMaxSpeed, 0.0, 1e3, true, false,
                                   "must be in (0, 1000] [m/s] (servo speed cap while the test runs)");
+  c.test.loopRest = t.boolean("loop_rest", c.test.loopRest);
   c.test.unloadToQFraction = t.number("unload_to_q_fraction", c.test.unloadToQFraction, 0.0, 1.0, false, true,
                                       "must be in [0, 1) (an unload ends at this fraction of the deviator at reversal)");
   t.finish();
@@ -686,6 +687,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
     test.insert("unload_reload_at", at);
   }
   test.insert("unload_to_q_fraction", c.test.unloadToQFraction);
+  test.insert("loop_rest", c.test.loopRest);
   test.insert("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
   test.insert("servo_max_speed", c.test.servoMaxSpeed);
   if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);

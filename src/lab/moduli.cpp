@@ -47,11 +47,16 @@ std::vector<UnloadReloadLoop> unloadReloadLoops(const std::vector<double>& eps1,
   std::vector<UnloadReloadLoop> loops;
   const std::size_t n = std::min({eps1.size(), q.size(), phase.size()});
   for (std::size_t i = 1; i < n; ++i) {
-    if (phase[i] == 1 && phase[i - 1] == 0) {
+    if ((phase[i] == 1 || phase[i] == 3) && phase[i - 1] == 0) {
       UnloadReloadLoop l;
       l.eps1Reversal = eps1[i];
-      l.qReversal = q[i];
+      l.qReversal = l.qLoaded = q[i];
       loops.push_back(l);
+    } else if (phase[i] == 1 && phase[i - 1] == 3 && !loops.empty()) {
+      // The last record of the rest: the unload starts here.
+      UnloadReloadLoop& l = loops.back();
+      l.qReversal = q[i];
+      if (l.qLoaded != 0.0) l.restRelaxation = (l.qLoaded - l.qReversal) / l.qLoaded;
     } else if (phase[i] == 2 && phase[i - 1] == 1 && !loops.empty()) {
       loops.back().eps1Turn = eps1[i];
       loops.back().qTurn = q[i];

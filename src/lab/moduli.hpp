@@ -42,6 +42,10 @@ std::optional<double> secantE50(const std::vector<double>& eps1, const std::vect
 // the 0 after a reload, where the reload regains the reversal strain).
 struct UnloadReloadLoop {
   double eps1Reversal = 0.0, qReversal = 0.0;  // where the unload began
+  double qLoaded = 0.0;                         // q when the platens stopped (before a rest)
+  // test.loop_rest: (qLoaded - qReversal)/qLoaded, the deviator relaxed at constant strain before
+  // the unload; null without a rest.
+  std::optional<double> restRelaxation;
   double eps1Turn = 0.0, qTurn = 0.0;          // where the reload began
   double eps1End = 0.0, qEnd = 0.0;            // where the reload regained the reversal strain
   // Eur: secant of the reload branch, (qEnd - qTurn)/(eps1End - eps1Turn); null when the reload

@@ -264,6 +264,7 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.loopPhase);
   put(out, st.loopQ);
   put(out, st.loopEndStep);
+  put(out, st.loopRestStart);
   put(out, st.slowdown);
 }
 
@@ -298,10 +299,11 @@ void Laboratory::loadState(std::istream& in) {
   get(in, st.loopPhase);
   get(in, st.loopQ);
   get(in, st.loopEndStep);
+  get(in, st.loopRestStart);
   get(in, st.slowdown);
   if (!(st.slowdown > 0.0 && st.slowdown <= 1.0)) throw std::runtime_error("inconsistent state: platen slow-down factor");
   if (st.loopNext < 0 || st.loopNext > static_cast<int>(config_.test.unloadReloadAt.size()) || st.loopPhase < 0 ||
-      st.loopPhase > 2 || (st.loopPhase != 0 && st.loopNext == static_cast<int>(config_.test.unloadReloadAt.size())))
+      st.loopPhase > 3 || (st.loopPhase == 3 && !config_.test.loopRest) || (st.loopPhase != 0 && st.loopNext == static_cast<int>(config_.test.unloadReloadAt.size())))
     throw std::runtime_error("inconsistent state: unload-reload loop state does not match test.unload_reload_at");
   sim_.validateState();
   if (records_.referencePosition.size() != sim_.particles.size() || records_.rotationPath.size() != sim_.particles.size() ||

@@ -61,7 +61,7 @@ struct Record {
   // external work: (W - dE_elastic - dE_kinetic - D_slip - D_roll - D_damping) / W; NaN while W = 0.
   double energyResidual = 0.0;
   // Triaxial unload–reload loops (test.unload_reload_at): 0 monotonic loading, 1 unloading,
-  // 2 reloading.
+  // 2 reloading, 3 at rest at the reversal strain before the unload (test.loop_rest).
   long loopPhase = 0;
 };
 
@@ -161,6 +161,10 @@ class Laboratory {
   static constexpr double kLoopSpeedFactor = 0.1;
   // Records during a loop every this fraction of output.record_every_strain of platen travel.
   static constexpr double kLoopRecordFraction = 1e-2;
+  // test.loop_rest: the rest ends when the unbalanced-force ratio is below kProbeUnbalanced (checked
+  // every kSlowdownCheckSteps steps) or after kLoopMaxRestSteps; a record every kLoopRestRecordSteps.
+  static constexpr long kLoopMaxRestSteps = 200'000;
+  static constexpr long kLoopRestRecordSteps = 200;
   // Platen slow-down: the unbalanced force is checked every kSlowdownCheckSteps steps; the speed
   // never falls below kMinPlatenSlowdown of the loading speed.
   static constexpr long kSlowdownCheckSteps = 10;
@@ -201,6 +205,7 @@ class Laboratory {
     int loopNext = 0, loopPhase = 0;
     double loopQ = 0.0;
     long loopEndStep = -1;
+    long loopRestStart = -1;   // the step a rest before an unload began (test.loop_rest)
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
   };

@@ -104,6 +104,10 @@ struct TestConfig {
   // at reversal, and the reload returns to the reversal strain.
   std::vector<double> unloadReloadAt;
   double unloadToQFraction = 0.5;
+  // Before each unload the platens stand still until the sample is at rest (unbalanced-force ratio
+  // below Laboratory::kProbeUnbalanced), so that Eur is measured from a relaxed state and the
+  // relaxation of q at constant strain is reported (docs/moduli.md).
+  bool loopRest = false;
   // Platens slow down while the unbalanced-force ratio exceeds this (speed x threshold/ratio, at
   // least kMinPlatenSlowdown), so that the lateral servos can follow a collapse; 0: off.
   double platenSlowdownUnbalanced = 0.0;

@@ -172,6 +172,7 @@ void Laboratory::driveBoundary(double ramp) {
 
 double Laboratory::loadingFactor() const {
   const ShearState& st = shear_;
+  if (st.loopPhase == 3) return 0.0;
   if (st.loopPhase == 1) return -kLoopSpeedFactor * st.slowdown;
   if (st.loopPhase == 2) return kLoopSpeedFactor * st.slowdown;
   const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps);
@@ -262,9 +263,19 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
       const double q = s[2] - 0.5 * (s[0] + s[1]);
       const bool more = st.loopNext < static_cast<int>(at.size());
       if (st.loopPhase == 0 && more && *strain >= at[st.loopNext]) {
-        st.loopPhase = 1;
+        st.loopPhase = config_.test.loopRest ? 3 : 1;
         st.loopQ = q;
+        st.loopRestStart = sim_.stepCount;
         st.forceRecord = true;
+      } else if (st.loopPhase == 3) {
+        // At rest before the unload: the unload starts from the relaxed deviator.
+        const long resting = sim_.stepCount - st.loopRestStart;
+        if (resting % kSlowdownCheckSteps == 0 &&
+            (resting >= kLoopMaxRestSteps || unbalancedForceRatio(sim_) < kProbeUnbalanced)) {
+          st.loopPhase = 1;
+          st.loopQ = q;
+          st.forceRecord = true;
+        }
       } else if (st.loopPhase == 1 && q <= config_.test.unloadToQFraction * st.loopQ) {
         st.loopPhase = 2;
         st.forceRecord = true;
@@ -277,7 +288,8 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     });
   pipeline.addAfter("record", [this, &st, strain, last, every, p] {
     const bool loopDue = st.loopPhase != 0 && !st.result.records.empty() &&
-                         std::abs(*strain - st.result.records.back().eps1) >= kLoopRecordFraction * every;
+                         (std::abs(*strain - st.result.records.back().eps1) >= kLoopRecordFraction * every ||
+                          (st.loopPhase == 3 && sim_.stepCount - st.result.records.back().step >= kLoopRestRecordSteps));
     if (!(*strain >= st.nextRecord || *last || st.forceRecord || loopDue)) return;
     st.forceRecord = false;
     const double samples = static_cast<double>(st.stressSamples);

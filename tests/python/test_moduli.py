@@ -120,3 +120,38 @@ def test_lateral_walls_follow_a_column_collapse(grainlab, tmp_path):
     assert default[1][1] == slow[1][1]  # the first record: the prepared sample, identical
     assert slow[0] > 0.15
     assert default[0] < 0.05
+
+
+def test_loop_rest_before_the_unload(grainlab, tmp_path):
+    """test.loop_rest: at the loop's strain the platens stand still (loop_phase 3, eps1 constant)
+    until the sample is at rest, then unload from the relaxed deviator; the summary reports the
+    relaxation of q during the rest, recomputed here from the records; without a rest it is null."""
+    out = tmp_path / "rest"
+    common = ["--quiet", "--threads", "1", "--set", "test.final_axial_strain=0.012",
+              "--set", "test.unload_reload_at=[0.005]"]
+    grainlab("run", SMALL, "--out", str(out), *common, "--set", "test.loop_rest=true", check=0, timeout=600)
+    s = json.loads((out / "summary.json").read_text())
+    rows = read_csv(out / "timeseries.csv")
+    head, rows = rows[0], rows[1:]
+    q, e1 = head.index("q"), head.index("eps1")
+    phases = [int(r[-1]) for r in rows]
+    # The phases in order: loading, rest, unloading, reloading, loading.
+    order = [p for i, p in enumerate(phases) if i == 0 or p != phases[i - 1]]
+    assert order == [0, 3, 1, 2, 0]
+    rest = [r for r, p in zip(rows, phases) if p == 3]
+    assert len(rest) >= 2 and len({r[e1] for r in rest}) == 1  # the platens stood still
+    first_rest = phases.index(3)
+    first_unload = phases.index(1)
+    q_loaded, q_rested = float(rows[first_rest][q]), float(rows[first_unload][q])
+    assert s["Eur_rest_q_relaxation"] == [pytest.approx((q_loaded - q_rested) / q_loaded, rel=1e-9)]
+    assert -1.0 < s["Eur_rest_q_relaxation"][0] < 1.0
+    assert s["Eur_MPa"][0] is not None and s["Eur_MPa"][0] > 0
+    assert "stood still" in s["Eur_method"]
+    # The unload went to half of the relaxed deviator, not of the loaded one.
+    turn = phases.index(2)
+    assert float(rows[turn][q]) <= 0.55 * q_rested
+    # Without a rest: the same loop, relaxation null.
+    plain = tmp_path / "plain"
+    grainlab("run", SMALL, "--out", str(plain), *common, check=0, timeout=600)
+    p = json.loads((plain / "summary.json").read_text())
+    assert p["Eur_rest_q_relaxation"] == [None] and "stood still" not in p["Eur_method"]

@@ -108,6 +108,19 @@ TEST(Moduli, UnloadReloadSecantOfASyntheticLoop) {
   const auto open = lab::unloadReloadLoops({0.0, 0.01, 0.009}, {0.0, 1.0, 0.5}, {0, 1, 1});
   ASSERT_EQ(open.size(), 1u);
   EXPECT_FALSE(open[0].eur.has_value());
+  EXPECT_FALSE(open[0].restRelaxation.has_value());
+  // A rest before the unload (phase 3, test.loop_rest): q at the first rest record is the loaded
+  // deviator, the unload starts from the last (the relaxed one: 0.8 of it, relaxation 0.2), and Eur
+  // is the secant from the turning point (0.45) to the reversal strain regained (0.7): 0.25/0.002.
+  const auto rested = lab::unloadReloadLoops({0.0, 0.01, 0.01, 0.01, 0.009, 0.008, 0.009, 0.01},
+                                             {0.0, 1.0, 0.9, 0.8, 0.6, 0.45, 0.6, 0.7}, {0, 3, 3, 1, 1, 2, 2, 0});
+  ASSERT_EQ(rested.size(), 1u);
+  EXPECT_DOUBLE_EQ(rested[0].qLoaded, 1.0);
+  EXPECT_DOUBLE_EQ(rested[0].qReversal, 0.8);
+  ASSERT_TRUE(rested[0].restRelaxation.has_value());
+  EXPECT_NEAR(*rested[0].restRelaxation, 0.2, 1e-12);
+  ASSERT_TRUE(rested[0].eur.has_value());
+  EXPECT_NEAR(*rested[0].eur, 0.25 / 0.002, 1e-9);
 }
 
 

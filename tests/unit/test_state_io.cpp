@@ -45,6 +45,7 @@ struct ShearStateMembers {
   int loopNext, loopPhase;
   double loopQ;
   long loopEndStep;
+  long loopRestStart;
   bool forceRecord;
   double slowdown;
 };
