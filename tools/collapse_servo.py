@@ -12,12 +12,11 @@ and agree up to the first collapse that reaches the cap.
 """
 import argparse
 import csv
-import json
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_runs import run_cases  # noqa: E402
+from study_runs import run_cases, summary, write_table  # noqa: E402
 
 CASES = [  # (name, label, the --set that makes the case)
     ("mu40", "μ = 40°", "contact.friction_deg=40"),
@@ -52,14 +51,12 @@ def main():
     for name, label, _ in CASES:
         for tag, cap in CAPS:
             folder = os.path.join(a.runs, f"{name}-{tag}")
-            s = json.load(open(os.path.join(folder, "summary.json")))
+            s = summary(folder)
             lines.append(f"| {label} | {s['e0']:.4f} | {cap:g} | {100 * s['lateral_stress_max_deviation']:.2f} | "
                          f"{100 * s['lateral_stress_max_deviation_single_wall']:.2f} | {collapses(folder)} | "
                          f"{s['phi_peak_deg']:.2f} | {s['psi_max_deg']:.2f} | {s['phi_res_deg']:.2f} | "
                          f"{s['wall_seconds']:.0f} |")
-    with open(a.out, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(a.out, lines)
     return 0
 
 

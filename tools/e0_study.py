@@ -17,12 +17,11 @@ issue 13 checked) and the overlays docs/results/e0-study/q.png, epsv.png and e.p
 """
 import argparse
 import csv
-import json
 import math
 import os
 import sys
 
-from study_runs import completed, run_cases  # noqa: E402 (tools/, beside this script)
+from study_runs import completed, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -98,8 +97,7 @@ def report(args):
     _, cases, name = study(args)
     for case, label, seed, folder, _ in case_dirs(args.runs, [1, 2, 3, 4], cases):
         if completed(folder):
-            with open(os.path.join(folder, "summary.json")) as f:
-                found.append((case, label, seed, folder, json.load(f), read_series(folder)))
+            found.append((case, label, seed, folder, summary(folder), read_series(folder)))
     if not found:
         print("no completed runs in", args.runs, file=sys.stderr)
         return 1
@@ -154,9 +152,7 @@ def report(args):
                 lines.append(f"| {tag} vs dense: same end state, q/p within 0.1 | {dq:.3f} → {'met' if dq <= 0.1 else 'missed'} |")
                 lines.append(f"| {tag} vs dense: same end state, e within 0.03 | {de:.3f} → {'met' if de <= 0.03 else 'missed'} |")
     path = os.path.join(args.docs, f"{name}-table.md")
-    with open(path, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(path, lines)
     return 0
 
 

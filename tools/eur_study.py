@@ -11,12 +11,11 @@ runs are skipped, so an interrupted call resumes.
 """
 import argparse
 import csv
-import json
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_runs import run_cases  # noqa: E402
+from study_runs import run_cases, summary, write_table  # noqa: E402
 
 LOOPS = ["test.unload_reload_at=[0.005,0.02]", "test.final_axial_strain=0.03"]
 AUTO_RATE_W = 1.1923383855050151  # the auto rate of w-base (I = 0.98e-3), from its summary.json
@@ -64,7 +63,7 @@ def main():
     lines = ["| case | E0 [MPa] | E50 [MPa] | q relaxed in the rest [%] | Eur 0.5 % [MPa] | Eur 2 % [MPa] | Eur/E0 (0.5 %) |",
              "|---|---:|---:|---:|---:|---:|---:|"]
     for name, _, label, _ in CASES:
-        s = json.load(open(os.path.join(a.runs, name, "summary.json")))
+        s = summary(os.path.join(a.runs, name))
         eur = s["Eur_MPa"]
         relax = [fmt(100 * r if r is not None else None, ".1f") for r in s.get("Eur_rest_q_relaxation") or [None, None]]
         lines.append(f"| {label} | {s['E0_MPa']:.0f} | {s['E50_MPa']:.0f} | {' / '.join(relax)} | {fmt(eur[0], '.0f')} | "
@@ -73,13 +72,11 @@ def main():
               "φp to 3 % [°] | E50 [MPa] |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for name, k in RATES:
         folder = os.path.join(a.runs, name)
-        s = json.load(open(os.path.join(folder, "summary.json")))
+        s = summary(folder)
         lines.append(f"| auto / {k} | {s['strain_rate']:.3f} | {s['inertial_number_max']:.2e} | {s['steps']} | "
                      f"{fmt(q_at(folder, 0.005), '.0f')} | {fmt(q_at(folder, 0.01), '.0f')} | {s['phi_peak_deg']:.1f} | "
                      f"{s['E50_MPa']:.0f} |")
-    with open(a.out, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(a.out, lines)
     return 0
 
 

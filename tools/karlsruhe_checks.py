@@ -13,11 +13,10 @@ docs/results/calibration-karlsruhe/checks_q.png and checks_epsv.png.
 """
 import argparse
 import csv
-import json
 import os
 import sys
 
-from study_runs import completed, run_cases  # noqa: E402 (tools/, beside this script)
+from study_runs import completed, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -67,8 +66,7 @@ def report(a):
         if not completed(folder):
             lines.append(f"| {label} | not run | | | | | | | | | | | | | |")
             continue
-        with open(os.path.join(folder, "summary.json")) as f:
-            s = json.load(f)
+        s = summary(folder)
         eps1, q, epsv, p, e = series(folder)
         end = [i for i, x in enumerate(eps1) if x >= 0.16]
         qp_end = sum(q[i] / p[i] for i in end) / len(end) if end else None
@@ -94,9 +92,8 @@ def report(a):
         ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(os.path.join(out_dir, name), dpi=100)
-    with open(os.path.join(a.docs, "calibration-karlsruhe-checks.md"), "w") as f:
-        f.write("<!-- written by tools/karlsruhe_checks.py report -->\n" + "\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_table(os.path.join(a.docs, "calibration-karlsruhe-checks.md"), lines,
+                header="<!-- written by tools/karlsruhe_checks.py report -->\n")
     return 0
 
 

@@ -1,5 +1,6 @@
-"""What the study tools (e0_study.py, karlsruhe_checks.py, wall_spheroids.py) share: whether a run
-folder holds a completed run, and a queue that runs `grainlab run` cases a few at a time."""
+"""What the study tools (e0_study.py, karlsruhe_checks.py, wall_spheroids.py, collapse_servo.py,
+eur_study.py) share: whether a run folder holds a completed run, its summary, a queue that runs
+`grainlab run` cases a few at a time, and writing a Markdown table."""
 import json
 import os
 import subprocess
@@ -13,6 +14,19 @@ def completed(folder):
             return json.load(f).get("status") == "completed"
     except (OSError, ValueError):
         return False
+
+
+def summary(folder):
+    """folder/summary.json as a dict."""
+    with open(os.path.join(folder, "summary.json")) as f:
+        return json.load(f)
+
+
+def write_table(path, lines, header=""):
+    """Writes the table's lines (after an optional header line) to path and prints them."""
+    with open(path, "w") as f:
+        f.write(header + "\n".join(lines) + "\n")
+    print("\n".join(lines))
 
 
 def run_cases(exe, preset, cases, jobs, nice=False):
