@@ -111,7 +111,7 @@ def test_lateral_walls_follow_a_column_collapse(grainlab, tmp_path):
     results = {}
     for tag, extra in (("test-cap", []), ("prep-cap", ["--set", "test.servo_max_speed=0.5"])):
         out = tmp_path / tag
-        grainlab("run", SMALL, "--set", "contact.eta=1", "--set", "test.probe_strain=1e-6", *extra,
+        grainlab("run", SMALL, "--set", "contact.eta=1", *extra,
                  "--out", str(out))
         summary = json.loads((out / "summary.json").read_text())
         rows = read_csv(out / "timeseries.csv")
