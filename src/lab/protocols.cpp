@@ -305,6 +305,8 @@ void Laboratory::loadState(std::istream& in) {
   if (st.loopNext < 0 || st.loopNext > static_cast<int>(config_.test.unloadReloadAt.size()) || st.loopPhase < 0 ||
       st.loopPhase > 3 || (st.loopPhase == 3 && !config_.test.loopRest) || (st.loopPhase != 0 && st.loopNext == static_cast<int>(config_.test.unloadReloadAt.size())))
     throw std::runtime_error("inconsistent state: unload-reload loop state does not match test.unload_reload_at");
+  if (st.loopPhase == 3 && !(st.loopRestStart >= st.startStep && st.loopRestStart <= sim_.stepCount))
+    throw std::runtime_error("inconsistent state: a loop's rest did not start during this test");
   sim_.validateState();
   if (records_.referencePosition.size() != sim_.particles.size() || records_.rotationPath.size() != sim_.particles.size() ||
       records_.referenceOrientation.size() != sim_.particles.size() || records_.sphericity.size() != sim_.particles.size())

@@ -112,7 +112,7 @@ struct TestConfig {
   // least kMinPlatenSlowdown), so that the lateral servos can follow a collapse; 0: off.
   double platenSlowdownUnbalanced = 0.0;
   // Speed cap of the boundary servos while the test runs [m/s] (cell: 2 x this / cell length as a
-  // rate). Above solver.servoMaxSpeed, which governs the preparation (walls that approach a loose
+  // rate). By default above solver.servoMaxSpeed, which governs the preparation (walls that approach a loose
   // cloud without contacts move at the cap there): in a test the lateral walls only reach the cap
   // when a force-chain column collapses and the sample contracts faster than 0.5 m/s lets them
   // follow (docs/moduli.md, "Lateral stress in column collapses").
