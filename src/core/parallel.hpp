@@ -6,6 +6,7 @@
 // reduction clause combines partials in completion order instead.)
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace grainlab {
@@ -14,21 +15,40 @@ class ChunkedSums {
  public:
   static constexpr std::size_t kChunk = 512;
 
-  ChunkedSums(std::size_t items, int terms)
-      : items_(items), terms_(terms), values_(chunks() * terms, 0.0) {}
-  std::size_t chunks() const { return (items_ + kChunk - 1) / kChunk; }
-  std::size_t begin(std::size_t chunk) const { return chunk * kChunk; }
-  std::size_t end(std::size_t chunk) const { return std::min(items_, (chunk + 1) * kChunk); }
+  ChunkedSums() = default;
+  ChunkedSums(std::size_t items, int terms, std::size_t chunk = kChunk) { reset(items, terms, chunk); }
+  // Re-cuts the sums for `items` items, `terms` terms per chunk and `chunk` items per chunk (keeps
+  // the storage; every chunk's terms must be written again before they are read).
+  void reset(std::size_t items, int terms, std::size_t chunk = kChunk) {
+    items_ = items;
+    terms_ = terms;
+    chunk_ = chunk;
+    values_.assign(chunks() * terms, 0.0);
+  }
+  std::size_t chunks() const { return (items_ + chunk_ - 1) / chunk_; }
+  std::size_t begin(std::size_t chunk) const { return chunk * chunk_; }
+  std::size_t end(std::size_t chunk) const { return std::min(items_, (chunk + 1) * chunk_); }
   double& at(std::size_t chunk, int term) { return values_[chunk * terms_ + term]; }
   double total(int term) const {
     double s = 0.0;
     for (std::size_t c = 0; c < values_.size() / terms_; ++c) s += values_[c * terms_ + term];
     return s;
   }
+  double maxOf(int term) const {
+    double m = -std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < values_.size() / terms_; ++c) m = std::max(m, values_[c * terms_ + term]);
+    return m;
+  }
+  double minOf(int term) const {
+    double m = std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < values_.size() / terms_; ++c) m = std::min(m, values_[c * terms_ + term]);
+    return m;
+  }
 
  private:
-  std::size_t items_;
-  int terms_;
+  std::size_t items_ = 0;
+  int terms_ = 1;
+  std::size_t chunk_ = kChunk;
   std::vector<double> values_;
 };
 

@@ -4,9 +4,9 @@
 
 namespace grainlab {
 
-Pipeline::Pipeline(Simulation& sim) {
+Pipeline::Pipeline(Simulation& sim) : sim_(sim) {
   for (const auto& stage : Simulation::engineStages())
-    stages_.push_back({stage.name, [&sim, fn = stage.run] { (sim.*fn)(); }, Trigger::always(), true});
+    stages_.push_back({stage.name, {}, Trigger::always(), true});  // run by sim_.step()
 }
 
 void Pipeline::addBefore(std::string name, Action action, Trigger trigger) {
@@ -29,10 +29,14 @@ long Pipeline::run() {
     for (std::size_t s = 0; s < stages_.size(); ++s) {
       if (s == firstEngine_ + Simulation::engineStages().size()) steps_ = n;
       Stage& st = stages_[s];
-      if (!st.engine) {
-        if (st.trigger.every > 1 && n % st.trigger.every != 0) continue;
-        if (st.trigger.when && !st.trigger.when()) continue;
+      if (st.engine) {
+        // The engine's stages run together as one step (one parallel region, Simulation::step);
+        // they are listed one by one for describe().
+        if (s == firstEngine_) sim_.step();
+        continue;
       }
+      if (st.trigger.every > 1 && n % st.trigger.every != 0) continue;
+      if (st.trigger.when && !st.trigger.when()) continue;
       st.action();
     }
     steps_ = n;

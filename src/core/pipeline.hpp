@@ -54,6 +54,7 @@ class Pipeline {
     Trigger trigger;
     bool engine;  // engine stages run every step, before the step counter advances
   };
+  Simulation& sim_;
   std::vector<Stage> stages_;
   std::size_t firstEngine_ = 0;
   bool stopping_ = false;

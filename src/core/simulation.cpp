@@ -4,6 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <stdexcept>
 
 #include "core/contact_driver.hpp"
@@ -35,25 +40,69 @@ void Simulation::initialise(double skinFraction) {
   rebuildDue_ = true;
 }
 
+namespace {
+// The engine stage each thread of the team is running (step() sets it; serial() reads it).
+thread_local int tStage = 0;
+}  // namespace
+
 void Simulation::step() {
-  for (const EngineStage& stage : engineStages()) (this->*stage.run)();
+  // One parallel region per step: the stages share the team (one fork/join instead of one per
+  // parallel stage). Every thread runs every stage, so every thread meets the same work-sharing
+  // constructs and barriers in the same order; the only branch on shared data is the check of
+  // failedStage_ at a stage's start, which every thread reads after the barrier that ended the
+  // failing serial part, and which a later failure cannot change for an earlier stage.
+  const std::vector<EngineStage>& stages = engineStages();
+  failedStage_.stage.store(StageFlag::kNone, std::memory_order_relaxed);
+  stageError_ = nullptr;
+#pragma omp parallel
+  {
+    for (int k = 0; k < static_cast<int>(stages.size()); ++k) {
+      if (failedStage_.stage.load(std::memory_order_relaxed) < k) break;
+      tStage = k;
+      (this->*stages[k].run)();
+    }
+  }
+  if (stageError_) {
+    std::exception_ptr e = stageError_;
+    stageError_ = nullptr;
+    std::rethrow_exception(e);
+  }
+}
+
+template <class F>
+void Simulation::serial(F&& body) {
+#pragma omp single
+  {
+    try {
+      body();
+    } catch (...) {
+      stageError_ = std::current_exception();
+      failedStage_.stage.store(tStage, std::memory_order_relaxed);
+    }
+  }
 }
 
 void Simulation::advanceClock() {
-  ++stepCount;
-  time += dt;
+  // The last stage: the barrier that ends the step's parallel region publishes the clock.
+#pragma omp single nowait
+  {
+    ++stepCount;
+    time += dt;
+  }
 }
 
 void Simulation::updateBroadPhase() {
-  if (boundary == Boundary::Periodic) {
-    if (!rebuildDue_) return;
-    wrapIntoCell();
-    broadPhase.buildPeriodic(particles, cell, contacts);
-  } else {
-    if (!rebuildDue_ && !broadPhase.wallsMoved(box)) return;
-    broadPhase.buildWalls(particles, box, contacts);
-  }
-  rebuildDue_ = false;
+  serial([&] {
+    if (boundary == Boundary::Periodic) {
+      if (!rebuildDue_) return;
+      wrapIntoCell();
+      broadPhase.buildPeriodic(particles, cell, contacts);
+    } else {
+      if (!rebuildDue_ && !broadPhase.wallsMoved(box)) return;
+      broadPhase.buildWalls(particles, box, contacts);
+    }
+    rebuildDue_ = false;
+  });
 }
 
 void Simulation::wrapIntoCell() {
@@ -85,41 +134,61 @@ void Simulation::wrapIntoCell() {
 
 template <bool Periodic>
 void Simulation::computeContactsFor() {
-  // Shape matrices of the step, once per ellipsoid, shared by its contacts.
+  // The lists are as the broad phase left them (it ended with a barrier): every thread sees the
+  // same kinds present.
   const bool ellipsoids = !contacts.ellipsoidEllipsoid.a.empty() || !contacts.sphereEllipsoid.a.empty() ||
                           !contacts.ellipsoidWall.a.empty();
-  if (ellipsoids) {
-    shapeMatrices_.resize(particles.size());
-    for (std::size_t i = 0; i < particles.size(); ++i)
-      if (particles.shape[i] == Shape::Ellipsoid)
-        shapeMatrices_[i] = geometry::shapeMatrix(particles.semiAxes[i], particles.orientation[i]);
-  }
-  const ContactContext ctx{particles, model, box, cell, dt, &shapeMatrices_};
   auto& pairs = contacts.sphereSphere;
   auto& walls = contacts.sphereWall;
   auto& ee = contacts.ellipsoidEllipsoid;
   auto& se = contacts.sphereEllipsoid;
   auto& ew = contacts.ellipsoidWall;
-  const int pairTerms = Periodic ? kContactSums : 2;
-  ChunkedSums pairSums(pairs.size(), pairTerms), wallSums(walls.size(), 2), eeSums(ee.size(), pairTerms),
-      seSums(se.size(), pairTerms), ewSums(ew.size(), 2);
-  // Every slot is written once after the list changed; then apart pairs are skipped.
-  std::array<bool, 5> writeAll{};
-  int k = 0;
-  contacts.forEach([&](auto& list) {
-    writeAll[k++] = list.slotsStale;
-    list.slotsStale = false;
-  });
-#pragma omp parallel
-  {
-    evaluateContacts<SphereSphere, Periodic>(pairs, ctx, pairSums, writeAll[0]);
-    if constexpr (!Periodic) evaluateContacts<SpherePlane, false>(walls, ctx, wallSums, writeAll[1]);
+  serial([&] {
+    // Shape matrices of the step, once per ellipsoid, shared by its contacts.
     if (ellipsoids) {
-      evaluateContacts<EllipsoidEllipsoid, Periodic>(ee, ctx, eeSums, writeAll[2]);
-      evaluateContacts<SphereEllipsoid, Periodic>(se, ctx, seSums, writeAll[3]);
-      if constexpr (!Periodic) evaluateContacts<EllipsoidPlane, false>(ew, ctx, ewSums, writeAll[4]);
+      shapeMatrices_.resize(particles.size());
+      for (std::size_t i = 0; i < particles.size(); ++i)
+        if (particles.shape[i] == Shape::Ellipsoid)
+          shapeMatrices_[i] = geometry::shapeMatrix(particles.semiAxes[i], particles.orientation[i]);
     }
+    const int pairTerms = Periodic ? kContactSums : 2;
+    pairSums_.reset(pairs.size(), pairTerms);
+    wallSums_.reset(walls.size(), 2);
+    eeSums_.reset(ee.size(), pairTerms);
+    seSums_.reset(se.size(), pairTerms);
+    ewSums_.reset(ew.size(), 2);
+    integrateSums_.reset(particles.size(), 3);  // the integrate stage's, cut here to save a barrier
+    // Every slot is written once after the list changed; then apart pairs are skipped.
+    int k = 0;
+    contacts.forEach([&](auto& list) {
+      writeAll_[k++] = list.slotsStale;
+      list.slotsStale = false;
+    });
+  });
+  const ContactContext ctx{particles, model, box, cell, dt, &shapeMatrices_};
+  // Work-shared loops without a barrier between kinds: a thread done with one kind's chunks takes
+  // the next kind's.
+  evaluateContacts<SphereSphere, Periodic>(pairs, ctx, pairSums_, writeAll_[0]);
+  if constexpr (!Periodic) evaluateContacts<SpherePlane, false>(walls, ctx, wallSums_, writeAll_[1]);
+  if (ellipsoids) {
+    evaluateContacts<EllipsoidEllipsoid, Periodic>(ee, ctx, eeSums_, writeAll_[2]);
+    evaluateContacts<SphereEllipsoid, Periodic>(se, ctx, seSums_, writeAll_[3]);
+    if constexpr (!Periodic) evaluateContacts<EllipsoidPlane, false>(ew, ctx, ewSums_, writeAll_[4]);
   }
+#pragma omp barrier
+  if constexpr (Periodic) {
+    serial([&] { sumContactTerms<Periodic>(ellipsoids); });  // the cell servo needs the stress next
+  } else {
+    // Energy sums only: nothing before the next barrier (the end of the wall-force loop) reads them.
+#pragma omp single nowait
+    sumContactTerms<Periodic>(ellipsoids);
+  }
+}
+
+template <bool Periodic>
+void Simulation::sumContactTerms(bool ellipsoids) {
+  const ChunkedSums &pairSums = pairSums_, &wallSums = wallSums_, &eeSums = eeSums_, &seSums = seSums_,
+                    &ewSums = ewSums_;
   energy.slip += pairSums.total(kSlip) + wallSums.total(kSlip);
   energy.rolling += pairSums.total(kRoll) + wallSums.total(kRoll);
   if (ellipsoids) {
@@ -171,28 +240,47 @@ void Simulation::gatherParticle(std::size_t i) {
 
 void Simulation::measureBoundary() {
   if (boundary == Boundary::Periodic) return;  // the cell's stress is summed by the contact stage
-  // The walls' forces, which their servos need.
-  for (Wall& wall : box.walls) {
-    wall.normalForce = 0.0;
-    wall.contactStiffness = 0.0;
-    wall.contacts = 0;
-  }
+  // The walls' forces, which their servos need. The walls are shared out across the team (thread g
+  // of T takes the walls k with k mod T = g, in one pass over the lists), and each wall sums its own
+  // contacts in list order, as one thread would: the same bits for any thread count. The loop's
+  // closing barrier publishes the sums to the servo stage.
+#ifdef _OPENMP
+  const int team = omp_get_num_threads();
+#else
+  const int team = 1;
+#endif
+#pragma omp for schedule(static)
+  for (int g = 0; g < team; ++g) sumWallForces(g, team);
+}
+
+void Simulation::sumWallForces(int group, int groups) {
+  const std::size_t walls = box.walls.size();
+  std::array<double, 6> force{}, stiffness{};
+  std::array<int, 6> touching{};
   auto sum = [&](const auto& list, const std::vector<double>& radius) {
     for (std::size_t c = 0; c < list.size(); ++c) {
-      if (!list.history[c].touching) continue;
-      Wall& wall = box.walls[list.b[c]];
-      wall.normalForce += list.force[c].dot(wall.inwardNormal());
-      wall.contactStiffness += model.wallParams(radius[list.a[c]], wall.tanFriction).kn;
-      ++wall.contacts;
+      const std::uint32_t k = list.b[c];
+      if (static_cast<int>(k % groups) != group || !list.history[c].touching) continue;
+      const Wall& wall = box.walls[k];
+      force[k] += list.force[c].dot(wall.inwardNormal());
+      stiffness[k] += model.wallParams(radius[list.a[c]], wall.tanFriction).kn;
+      ++touching[k];
     }
   };
   sum(contacts.sphereWall, particles.radius);
   sum(contacts.ellipsoidWall, particles.equivalentRadius);
+  for (std::size_t k = static_cast<std::size_t>(group); k < walls; k += static_cast<std::size_t>(groups)) {
+    box.walls[k].normalForce = force[k];
+    box.walls[k].contactStiffness = stiffness[k];
+    box.walls[k].contacts = touching[k];
+  }
 }
 
 void Simulation::controlBoundary() {
-  if (boundary == Boundary::Periodic) controlCell();
-  else controlWalls();
+  serial([&] {
+    if (boundary == Boundary::Periodic) controlCell();
+    else controlWalls();
+  });
 }
 
 void Simulation::controlWalls() {
@@ -281,9 +369,19 @@ void Simulation::integrate() {
   else integrateFor<false>();
 }
 
+namespace {
+// Cundall's local damping, -alpha |f_k| sign(v_k) per component (nothing where v_k = 0), as one
+// array expression: built component by component, it went through the stack and was read back
+// with a wider load than it was written with (a store-forwarding stall, the integrator's hottest
+// instructions in the profile). Multiplying by sign(v) = +-1 is exact, so the bits are those of
+// copysign(|f_k|, v_k).
+inline Vec3 localDampingForce(const Vec3& f, const Vec3& v, double alpha) {
+  return ((-alpha) * f.array().abs() * v.array().sign()).matrix();
+}
+}  // namespace
+
 template <bool Periodic>
 void Simulation::integrateFor() {
-  const std::size_t n = particles.size();
   auto& x = particles.position;
   auto& v = particles.velocity;
   auto& q = particles.orientation;
@@ -298,14 +396,15 @@ void Simulation::integrateFor() {
   // has carried each particle's build position (F x_build, F = H H_build^-1).
   const Mat3 flowStep = cell.flowStep(h);
   const Mat3 deformation = Periodic ? broadPhase.cellDeformation(cell) : Mat3::Identity();
-  double maxDisp2 = 0.0;
-  long badParticle = -1;
-  ChunkedSums dampingWork(n, 1);
+  // Per chunk: the damping work, the largest squared displacement since the build and the first
+  // particle that went bad (+inf when none). The sums were cut for n particles by the contact stage.
+  enum : int { kWork = 0, kDisp2, kBad };
+  ChunkedSums& sums = integrateSums_;
 
-#pragma omp parallel for schedule(static) reduction(max : maxDisp2)
-  for (std::size_t chunk = 0; chunk < dampingWork.chunks(); ++chunk) {
-  double work = 0.0;
-  for (std::size_t i = dampingWork.begin(chunk); i < dampingWork.end(chunk); ++i) {
+#pragma omp for schedule(static)
+  for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
+  double work = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
+  for (std::size_t i = sums.begin(chunk); i < sums.end(chunk); ++i) {
     gatherParticle(i);
     // Cundall local damping per component, against the sign of the current (mid-step) velocity.
     Vec3 f = particles.force[i] + particles.mass[i] * gravity;
@@ -318,7 +417,7 @@ void Simulation::integrateFor() {
       fd = kick.dampingForce;
       v[i] = kick.momentum * particles.invMass[i];
     } else {
-      for (int k = 0; k < 3; ++k) fd[k] = -alpha * std::copysign(std::abs(f[k]), v[i][k]) * (v[i][k] != 0.0);
+      fd = localDampingForce(f, v[i], alpha);
       v[i] += (f + fd) * (h * particles.invMass[i]);
     }
     if (particles.shape[i] == Shape::Ellipsoid) {
@@ -339,11 +438,10 @@ void Simulation::integrateFor() {
         td = kick.dampingForce;
         w[i] = kick.momentum * particles.invInertia[i];
       } else {
-        for (int k = 0; k < 3; ++k) td[k] = -alpha * std::copysign(std::abs(t[k]), w[i][k]) * (w[i][k] != 0.0);
+        td = localDampingForce(t, w[i], alpha);
         w[i] += (t + td) * (h * particles.invInertia[i]);
       }
-      const double wNorm = w[i].norm();
-      if (wNorm > 0.0) {
+      if (w[i].squaredNorm() > 0.0) {
         // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
         const Vec3 half = 0.5 * h * w[i];
         Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
@@ -368,16 +466,27 @@ void Simulation::integrateFor() {
       const double r = particles.radius[i];
       inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
     }
-    if (!finite || !inside) {
-#pragma omp critical
-      if (badParticle < 0 || static_cast<long>(i) < badParticle) badParticle = static_cast<long>(i);
-    }
+    if ((!finite || !inside) && !(badParticle < static_cast<double>(i))) badParticle = static_cast<double>(i);
   }
-  dampingWork.at(chunk, 0) = work;
+  sums.at(chunk, kWork) = work;
+  sums.at(chunk, kDisp2) = maxDisp2;
+  sums.at(chunk, kBad) = badParticle;
   }
-  energy.damping -= dampingWork.total(0);
-  if (badParticle >= 0) {
-    const std::size_t i = static_cast<std::size_t>(badParticle);
+  serial([&] { finishIntegration<Periodic>(deformation); });
+}
+
+template <bool Periodic>
+void Simulation::finishIntegration(const Mat3& deformation) {
+  enum : int { kWork = 0, kDisp2, kBad };
+  const ChunkedSums& sums = integrateSums_;
+  auto& x = particles.position;
+  auto& v = particles.velocity;
+  auto& w = particles.angularVelocity;
+  energy.damping -= sums.total(kWork);
+  const double maxDisp2 = std::max(0.0, sums.maxOf(kDisp2));
+  const double bad = sums.minOf(kBad);
+  if (std::isfinite(bad)) {
+    const std::size_t i = static_cast<std::size_t>(bad);
     const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
     throw SimulationError(fmt::format(
         "numerical instability at step {}: particle {} {} (position {:.6g} {:.6g} {:.6g}, "

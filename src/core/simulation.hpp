@@ -8,6 +8,9 @@
 //
 // Laboratory protocols run the same stages inside a Pipeline (core/pipeline.hpp) with their own
 // drives, recorders and stop conditions around them.
+#include <array>
+#include <atomic>
+#include <exception>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -15,6 +18,7 @@
 #include "contact/models.hpp"
 #include "core/broad_phase.hpp"
 #include "core/contact_list.hpp"
+#include "core/parallel.hpp"
 #include "core/particles.hpp"
 #include "core/periodic_cell.hpp"
 #include "core/servo_settings.hpp"
@@ -29,6 +33,19 @@ struct EnergyLedger {
   double rolling = 0.0;
   double damping = 0.0;
   double boundaryWork = 0.0;  // work done on the particles by the walls or the deforming cell
+};
+
+// The engine stage that failed during a step, shared by the threads of the step's team (an atomic,
+// but copyable: a copied simulation starts its next step clean).
+struct StageFlag {
+  static constexpr int kNone = 1 << 30;
+  std::atomic<int> stage{kNone};
+  StageFlag() = default;
+  StageFlag(const StageFlag&) {}
+  StageFlag& operator=(const StageFlag&) {
+    stage.store(kNone, std::memory_order_relaxed);
+    return *this;
+  }
 };
 
 enum class Boundary : std::uint8_t { Walls = 0, Periodic = 1 };
@@ -60,7 +77,9 @@ class Simulation {
   // Critical time step (PHYSICS.md §4): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
   // the stiffest contact the particle can have (against a wall).
   double criticalTimeStep() const;
-  // One step: every engine stage in order.
+  // One step: every engine stage in order, inside one OpenMP parallel region (one fork/join per
+  // step). Stages share the team: loops are work-shared, serial parts run on one thread between
+  // barriers (serial()). An error in a serial part skips the rest of the step and is rethrown here.
   void step();
 
   // The engine stages, in the order step() runs them.
@@ -97,14 +116,34 @@ class Simulation {
   void computeContactsFor();
   template <bool Periodic>
   void integrateFor();
+  // The serial ends of the stages (one thread, inside serial()).
+  template <bool Periodic>
+  void sumContactTerms(bool ellipsoids);
+  void sumWallForces(int group, int groups);
+  template <bool Periodic>
+  void finishIntegration(const Mat3& deformation);
   void controlWalls();
   void controlCell();
   void setCellGradient();
   void wrapIntoCell();
   void saveCell(std::ostream& out) const;
   void loadCell(std::istream& in);
+  // Runs `body` on one thread of the team (all threads wait at its end); an exception is kept and
+  // rethrown by step() after the parallel region, and the stages after it are skipped.
+  template <class F>
+  void serial(F&& body);
+  bool stageFailed() const;
   bool rebuildDue_ = true;
   std::vector<geometry::Sym3> shapeMatrices_;  // scratch of the contact stage (ellipsoids)
+  // Per-chunk sums of the step, shared by the team (core/parallel.hpp): contact energies and cell
+  // terms per pair kind, then the integrator's damping work, largest displacement and first bad
+  // particle.
+  ChunkedSums pairSums_, wallSums_, eeSums_, seSums_, ewSums_, integrateSums_;
+  std::array<bool, 5> writeAll_{};
+  // Index of the engine stage whose serial part threw during the current step (a large value when
+  // none); the stages after it do nothing.
+  StageFlag failedStage_;
+  std::exception_ptr stageError_;
 };
 
 }  // namespace grainlab

@@ -77,8 +77,11 @@ static_assert(stateio::fieldCount<lab::GrainRecords>() == 5, "GrainRecords chang
 static_assert(sizeof(Simulation) ==
                   layoutSize<Particles, Boundary, WallBox, PeriodicCell, ContactStore, BroadPhase,
                              contact::SphereContactModel, ServoSettings, EnergyLedger, Vec3, double, double, double,
-                             long, double, bool, std::vector<geometry::Sym3>>(),
-              "Simulation changed: update Simulation::saveState/loadState and this list (shape matrices are scratch)");
+                             long, double, bool, std::vector<geometry::Sym3>, ChunkedSums, ChunkedSums, ChunkedSums,
+                             ChunkedSums, ChunkedSums, ChunkedSums, std::array<bool, 5>, StageFlag,
+                             std::exception_ptr>(),
+              "Simulation changed: update Simulation::saveState/loadState and this list (shape matrices, the "
+              "step's chunk sums and error state are scratch)");
 static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
