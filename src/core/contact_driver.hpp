@@ -254,8 +254,8 @@ struct KindKernel<EllipsoidPlane, Periodic> : WallKernelBase<EllipsoidPlane, tru
 
 }  // namespace detail
 
-// Evaluates every contact of `list`; call inside an OpenMP parallel region (the loop is a
-// work-shared `omp for` without a barrier at its end). `sums` holds kContactSums terms per chunk
+// Evaluates every contact of `list`; call from every thread of an OpenMP parallel region (the loop
+// is a work-shared `omp for` without a barrier at its end). `sums` holds kContactSums terms per chunk
 // when Periodic, else kSlip and kRoll.
 template <class Kind, bool Periodic>
 void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, ChunkedSums& sums, bool writeAll) {
@@ -291,10 +291,17 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
         h.touching = true;
         h.prevNormal = g.normal;
       }
-      contact::ContactKinematics k = Kernel::kinematics(ctx, list, c, g, branch);
-      k.prevNormal = h.prevNormal;
       const contact::PairParams p = Kernel::params(ctx, list, c);
-      const contact::ContactResponse res = contact::applyLaw(p, k, h);
+      contact::ContactResponse res;
+      if (p.tanFriction <= 0.0 && p.kr <= 0.0) {
+        // Frictionless and without a moment spring (a smooth wall, a growth stage at mu = 0): the
+        // normal spring alone, without the kinematics the tangential and moment slots need.
+        res = contact::applyNormalLaw(p, g.normal, g.overlap, h);
+      } else {
+        contact::ContactKinematics k = Kernel::kinematics(ctx, list, c, g, branch);
+        k.prevNormal = h.prevNormal;
+        res = contact::applyLaw(p, k, h);
+      }
       Kernel::store(list, c, g, res);
       slip += res.slipDissipation;
       roll += res.rollDissipation;

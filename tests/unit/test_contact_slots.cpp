@@ -115,3 +115,40 @@ TEST_P(LawMoment, GrowsAsKrThetaAndPlateaus) {
 
 INSTANTIATE_TEST_SUITE_P(BendingAndTwisting, LawMoment,
                          ::testing::Values(Vec3::UnitX(), Vec3::UnitZ()));
+
+// The smooth-contact shortcut (tan mu = 0, kr = 0: smooth walls, growth at mu = 0) gives the force of
+// the full law, whatever shear and moment the history carried in and however the bodies move; the
+// full law scales its trial shear to the zero Coulomb limit and leaves the moment slot off.
+TEST(NormalOnlyLaw, EqualsTheFullLawWithoutFrictionOrMoment) {
+  const contact::SphereContactModel model;
+  contact::PairParams p = model.wallParams(2e-3, 0.0);
+  ASSERT_EQ(p.tanFriction, 0.0);
+  ASSERT_EQ(p.kr, 0.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double a = 0.37 * trial, b = 0.11 * trial * trial;
+    contact::ContactKinematics k;
+    k.normal = Vec3(std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a));
+    k.prevNormal = (k.normal + Vec3(1e-3 * std::cos(b), 2e-3, -1e-3 * std::sin(a))).normalized();
+    k.overlap = 1e-6 * (1 + trial % 7);
+    k.relativeVelocity = Vec3(0.01 * std::cos(3 * a), -0.02, 0.005 * trial);
+    k.relativeSpin = Vec3(1.0, -2.0 * std::sin(b), 0.5);
+    k.meanSpinNormal = 0.3;
+    k.dt = 1e-6;
+    contact::ContactHistory full, shortcut;
+    full.shearForce = shortcut.shearForce = Vec3(0.1 * trial, -0.05, 0.02);  // left over from friction
+    full.moment = shortcut.moment = Vec3(1e-4, 0.0, -2e-4);
+    full.prevNormal = shortcut.prevNormal = k.prevNormal;
+    full.touching = shortcut.touching = true;
+    const contact::ContactResponse r1 = contact::applyLaw(p, k, full);
+    const contact::ContactResponse r2 = contact::applyNormalLaw(p, k.normal, k.overlap, shortcut);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(r1.force[i] + 0.0, r2.force[i] + 0.0) << "trial " << trial;  // (+0.0: the sign of a zero)
+      EXPECT_EQ(r1.moment[i] + 0.0, r2.moment[i] + 0.0);
+      EXPECT_EQ(full.shearForce[i] + 0.0, shortcut.shearForce[i] + 0.0);
+      EXPECT_EQ(full.moment[i] + 0.0, shortcut.moment[i] + 0.0);
+    }
+    EXPECT_EQ(r1.slipDissipation, r2.slipDissipation);
+    EXPECT_EQ(r1.rollDissipation, r2.rollDissipation);
+    EXPECT_EQ(full.prevNormal, shortcut.prevNormal);
+  }
+}
