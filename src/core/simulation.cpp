@@ -47,10 +47,11 @@ thread_local int tStage = 0;
 
 void Simulation::step() {
   // One parallel region per step: the stages share the team (one fork/join instead of one per
-  // parallel stage). Every thread runs every stage, so every thread meets the same work-sharing
-  // constructs and barriers in the same order; the only branch on shared data is the check of
-  // failedStage_ at a stage's start, which every thread reads after the barrier that ended the
-  // failing serial part, and which a later failure cannot change for an earlier stage.
+  // parallel stage). Every thread runs every stage and so meets the same work-sharing constructs
+  // and barriers in the same order: outside serial parts, stages branch only on what no thread
+  // changes during the step (the boundary kind, which lists are empty) and on failedStage_ at a
+  // stage's start, which every thread reads after the barrier that ended the failing serial part,
+  // and which a later failure cannot change for an earlier stage.
   const std::vector<EngineStage>& stages = engineStages();
   failedStage_.stage.store(StageFlag::kNone, std::memory_order_relaxed);
   stageError_ = nullptr;
