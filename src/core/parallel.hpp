@@ -16,18 +16,17 @@ class ChunkedSums {
   static constexpr std::size_t kChunk = 512;
 
   ChunkedSums() = default;
-  ChunkedSums(std::size_t items, int terms, std::size_t chunk = kChunk) { reset(items, terms, chunk); }
-  // Re-cuts the sums for `items` items, `terms` terms per chunk and `chunk` items per chunk (keeps
-  // the storage; every chunk's terms must be written again before they are read).
-  void reset(std::size_t items, int terms, std::size_t chunk = kChunk) {
+  ChunkedSums(std::size_t items, int terms) { reset(items, terms); }
+  // Re-cuts the sums for `items` items and `terms` terms per chunk (keeps the storage; every
+  // chunk's terms must be written again before they are read).
+  void reset(std::size_t items, int terms) {
     items_ = items;
     terms_ = terms;
-    chunk_ = chunk;
     values_.assign(chunks() * terms, 0.0);
   }
-  std::size_t chunks() const { return (items_ + chunk_ - 1) / chunk_; }
-  std::size_t begin(std::size_t chunk) const { return chunk * chunk_; }
-  std::size_t end(std::size_t chunk) const { return std::min(items_, (chunk + 1) * chunk_); }
+  std::size_t chunks() const { return (items_ + kChunk - 1) / kChunk; }
+  std::size_t begin(std::size_t chunk) const { return chunk * kChunk; }
+  std::size_t end(std::size_t chunk) const { return std::min(items_, (chunk + 1) * kChunk); }
   double& at(std::size_t chunk, int term) { return values_[chunk * terms_ + term]; }
   double total(int term) const {
     double s = 0.0;
@@ -48,7 +47,6 @@ class ChunkedSums {
  private:
   std::size_t items_ = 0;
   int terms_ = 1;
-  std::size_t chunk_ = kChunk;
   std::vector<double> values_;
 };
 

@@ -158,7 +158,7 @@ void Simulation::computeContactsFor() {
     eeSums_.reset(ee.size(), pairTerms);
     seSums_.reset(se.size(), pairTerms);
     ewSums_.reset(ew.size(), 2);
-    integrateSums_.reset(particles.size(), 3);  // the integrate stage's, cut here to save a barrier
+    integrateSums_.reset(particles.size(), kIntegrateSums);  // the integrate stage's, cut here to save a barrier
     // Every slot is written once after the list changed; then apart pairs are skipped.
     int k = 0;
     contacts.forEach([&](auto& list) {
@@ -255,9 +255,9 @@ void Simulation::measureBoundary() {
 }
 
 void Simulation::sumWallForces(int group, int groups) {
-  const std::size_t walls = box.walls.size();
-  std::array<double, 6> force{}, stiffness{};
-  std::array<int, 6> touching{};
+  constexpr std::size_t walls = std::tuple_size_v<decltype(box.walls)>;
+  std::array<double, walls> force{}, stiffness{};
+  std::array<int, walls> touching{};
   auto sum = [&](const auto& list, const std::vector<double>& radius) {
     for (std::size_t c = 0; c < list.size(); ++c) {
       const std::uint32_t k = list.b[c];
@@ -397,9 +397,7 @@ void Simulation::integrateFor() {
   // has carried each particle's build position (F x_build, F = H H_build^-1).
   const Mat3 flowStep = cell.flowStep(h);
   const Mat3 deformation = Periodic ? broadPhase.cellDeformation(cell) : Mat3::Identity();
-  // Per chunk: the damping work, the largest squared displacement since the build and the first
-  // particle that went bad (+inf when none). The sums were cut for n particles by the contact stage.
-  enum : int { kWork = 0, kDisp2, kBad };
+  // Per chunk: the IntegrateSum terms; the sums were cut for the particles by the contact stage.
   ChunkedSums& sums = integrateSums_;
 
 #pragma omp for schedule(static)
@@ -469,23 +467,22 @@ void Simulation::integrateFor() {
     }
     if ((!finite || !inside) && !(badParticle < static_cast<double>(i))) badParticle = static_cast<double>(i);
   }
-  sums.at(chunk, kWork) = work;
+  sums.at(chunk, kDampingWork) = work;
   sums.at(chunk, kDisp2) = maxDisp2;
-  sums.at(chunk, kBad) = badParticle;
+  sums.at(chunk, kBadParticle) = badParticle;
   }
   serial([&] { finishIntegration<Periodic>(deformation); });
 }
 
 template <bool Periodic>
 void Simulation::finishIntegration(const Mat3& deformation) {
-  enum : int { kWork = 0, kDisp2, kBad };
   const ChunkedSums& sums = integrateSums_;
   auto& x = particles.position;
   auto& v = particles.velocity;
   auto& w = particles.angularVelocity;
-  energy.damping -= sums.total(kWork);
+  energy.damping -= sums.total(kDampingWork);
   const double maxDisp2 = std::max(0.0, sums.maxOf(kDisp2));
-  const double bad = sums.minOf(kBad);
+  const double bad = sums.minOf(kBadParticle);
   if (std::isfinite(bad)) {
     const std::size_t i = static_cast<std::size_t>(bad);
     const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();

@@ -132,12 +132,16 @@ class Simulation {
   // rethrown by step() after the parallel region, and the stages after it are skipped.
   template <class F>
   void serial(F&& body);
-  bool stageFailed() const;
   bool rebuildDue_ = true;
   std::vector<geometry::Sym3> shapeMatrices_;  // scratch of the contact stage (ellipsoids)
   // Per-chunk sums of the step, shared by the team (core/parallel.hpp): contact energies and cell
-  // terms per pair kind, then the integrator's damping work, largest displacement and first bad
-  // particle.
+  // terms per pair kind, then the integrator's terms below.
+  enum IntegrateSum : int {
+    kDampingWork = 0,  // work of the damping forces
+    kDisp2,            // largest squared displacement since the list was built
+    kBadParticle,      // first particle that went bad (+inf when none)
+    kIntegrateSums,
+  };
   ChunkedSums pairSums_, wallSums_, eeSums_, seSums_, ewSums_, integrateSums_;
   std::array<bool, 5> writeAll_{};
   // Index of the engine stage whose serial part threw during the current step (a large value when
