@@ -174,7 +174,7 @@ class ContactList {
     putVector(out, torqueA);
     putVector(out, torqueB);
   }
-  void loadState(std::istream& in, std::size_t nParticles) {
+  void loadState(std::istream& in) {
     using namespace stateio;
     getVector(in, a);
     getVector(in, b);
@@ -183,9 +183,13 @@ class ContactList {
     getVector(in, force);
     getVector(in, torqueA);
     getVector(in, torqueB);
-    buildIncidence(nParticles);
+    incidentStart.clear();
+    incident.clear();
     slotsStale = true;
   }
+  // The per-particle lists of a loaded state, built only once its indices have been validated
+  // (Simulation::validateState): an index read from a file is never used before it is checked.
+  void deriveAfterLoad(std::size_t nParticles) { buildIncidence(nParticles); }
 
  private:
   void buildIncidence(std::size_t n) {

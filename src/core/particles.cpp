@@ -157,7 +157,10 @@ void Particles::loadState(std::istream& in) {
   getVector(in, image);
   getVector(in, principalInertia);
   getVector(in, angularMomentum);
-  // Derived: the equivalent radius of each shape.
+}
+
+void Particles::deriveAfterLoad() {
+  // Called only after Simulation::validateState() has checked every array's size and value.
   equivalentRadius.resize(semiAxes.size());
   for (std::size_t i = 0; i < semiAxes.size(); ++i)
     equivalentRadius[i] = shape[i] == Shape::Sphere ? radius[i] : geometry::equivalentRadius(semiAxes[i]);

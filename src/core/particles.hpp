@@ -82,7 +82,10 @@ struct Particles {
   void permute(const std::vector<std::uint32_t>& order);
   // Exact binary state for checkpoints (state_io.hpp).
   void saveState(std::ostream& out) const;
+  // Reads the stored arrays only; nothing is derived from them until deriveAfterLoad(), which the
+  // caller runs after the loaded state has been validated (a forged file must not index anything).
   void loadState(std::istream& in);
+  void deriveAfterLoad();
 };
 
 }  // namespace grainlab

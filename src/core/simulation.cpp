@@ -596,7 +596,7 @@ void Simulation::loadState(std::istream& in) {
   get(in, box);
   loadCell(in);
   broadPhase.loadState(in);
-  contacts.forEach([&](auto& list) { list.loadState(in, particles.size()); });
+  contacts.forEach([&](auto& list) { list.loadState(in); });
   get(in, model);
   get(in, servo);
   get(in, energy);
@@ -607,6 +607,10 @@ void Simulation::loadState(std::istream& in) {
   get(in, stepCount);
   get(in, time);
   get(in, rebuildDue_);
+  // Everything above is raw data from a file: check it before anything is derived from it.
+  validateState();
+  particles.deriveAfterLoad();
+  contacts.forEach([&](auto& list) { list.deriveAfterLoad(particles.size()); });
 }
 
 }  // namespace grainlab

@@ -45,7 +45,8 @@ void Simulation::validateState() const {
   sameSize(P.principalInertia, n, "principal inertia");
   sameSize(P.angularMomentum, n, "angular momentum");
   for (std::size_t i = 0; i < n; ++i) {
-    if (!finite(P.position[i]) || !finite(P.velocity[i]) || !finite(P.angularVelocity[i]) ||
+    if (!finite(P.position[i]) || !finite(P.velocity[i]) || !finite(P.angularVelocity[i]) || !finite(P.force[i]) ||
+        !finite(P.torque[i]) || !finite(P.angularMomentum[i]) || !finite(P.principalInertia[i]) ||
         !P.orientation[i].coeffs().allFinite())
       bad(fmt::format("particle {}: non-finite state", i));
     if (P.shape[i] != Shape::Sphere && P.shape[i] != Shape::Ellipsoid) bad(fmt::format("particle {}: unknown shape", i));
@@ -86,6 +87,43 @@ void Simulation::validateState() const {
   for (int a = 0; a < 3; ++a) cells *= std::max(1.0, extent[a] / (2.0 * rMax));
   if (cells > 64.0 * static_cast<double>(n) + 1e6) bad("the boundary is far too large for its particles");
   if (!(dt > 0.0) || !std::isfinite(dt)) bad("time step not positive");
+  // The settings the engine carries in its state: enumerations within their values, numbers finite
+  // and in the ranges a config allows (a forged file may hold anything).
+  auto finiteIn = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  if (!finiteIn(model.young, 1e-300, 1e300) || !finiteIn(model.poisson, 0.0, 1.0) ||
+      !finiteIn(model.tanFriction, 0.0, 1e300) || !finiteIn(model.beta, 0.0, 1e300) || !finiteIn(model.eta, 0.0, 1e300) ||
+      !finiteIn(model.constantKn, 0.0, 1e300))
+    bad("contact model parameters not finite or out of range");
+  if (model.rolling != contact::RollingLaw::KozickiDonze && model.rolling != contact::RollingLaw::Linear)
+    bad("unknown rolling law");
+  if (model.combine != contact::CombineRule::Min && model.combine != contact::CombineRule::Mean &&
+      model.combine != contact::CombineRule::Harmonic)
+    bad("unknown rolling-friction combination rule");
+  if (!finiteIn(servo.gain, 0.0, 1.0) || !finiteIn(servo.integralSteps, 0.0, 1e300) || !finiteIn(servo.maxSpeed, 0.0, 1e300))
+    bad("servo settings not finite or out of range");
+  if (!std::isfinite(energy.slip) || !std::isfinite(energy.rolling) || !std::isfinite(energy.damping) ||
+      !std::isfinite(energy.boundaryWork) || !gravity.allFinite())
+    bad("energy ledger or gravity not finite");
+  if (!finiteIn(localDamping, 0.0, 1.0) || !finiteIn(viscousDamping, 0.0, 1e300)) bad("damping out of range");
+  if (stepCount < 0 || !finiteIn(time, 0.0, 1e300)) bad("step count or time negative or not finite");
+  for (double r : P.rollingFriction)
+    if (!finiteIn(r, 0.0, 1e300)) bad("rolling friction not finite and >= 0");
+  if (boundary == Boundary::Walls) {
+    for (const Wall& w : box.walls)
+      if ((w.control != WallControl::Fixed && w.control != WallControl::Velocity && w.control != WallControl::Stress) ||
+          !std::isfinite(w.targetStress) || !finiteIn(w.tanFriction, 0.0, 1e300))
+        bad("wall control, target stress or friction invalid");
+  } else {
+    auto knownControl = [](CellControl c) { return c == CellControl::StrainRate || c == CellControl::Stress; };
+    for (int k = 0; k < 3; ++k)
+      if (!knownControl(cell.control[k]) || !knownControl(cell.shearControl[k])) bad("unknown cell control");
+    if (!cell.velocityGradient.allFinite() || !cell.targetStress.allFinite() || !cell.strainRate.allFinite() ||
+        !cell.referenceLength.allFinite() || !(cell.referenceLength.minCoeff() > 0.0) ||
+        !cell.targetShearStress.allFinite() || !cell.shearServoIntegral.allFinite() || !std::isfinite(cell.shearRate) ||
+        !cell.servoIntegral.allFinite() || !cell.stress.allFinite() || !cell.stiffness.allFinite() ||
+        !cell.shearStiffness.allFinite())
+      bad("periodic cell state not finite");
+  }
   if (!(broadPhase.skin > 0.0) || !(broadPhase.skin <= 2.0 * rMin)) bad(fmt::format("neighbour skin {}", broadPhase.skin));
   if (!broadPhase.positionsAtBuild().empty()) sameSize(broadPhase.positionsAtBuild(), n, "build positions");
   contacts.forEach([&](const auto& list) {

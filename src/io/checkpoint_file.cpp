@@ -147,8 +147,29 @@ Checkpoint decodeCheckpoint(std::string_view bytes, const std::filesystem::path&
 }
 
 Checkpoint readCheckpointFile(const std::filesystem::path& file) {
+  // The header's sizes are checked against the file's length and this machine's memory before the
+  // rest is read: a sparse file of tens of GiB (or a header that claims it) is refused at once
+  // rather than read whole.
+  const auto vet = [&](std::string_view head, std::uintmax_t size) {
+    auto refuse = [&](const std::string& why) {
+      return InputError(fmt::format("checkpoint {}: {}", quotedPath(file), why));
+    };
+    if (!head.empty() && head[0] == '{') return;  // an earlier format: decodeCheckpoint names it
+    if (head.size() < kHeaderBytes) return;        // truncated: decodeCheckpoint names it
+    if (std::memcmp(head.data(), kMagic, sizeof(kMagic)) != 0) throw refuse("not a grainlab checkpoint (wrong magic bytes)");
+    const auto metaSize = getLE<std::uint64_t>(head, 64);
+    const auto stateSize = getLE<std::uint64_t>(head, 72);
+    const std::uintmax_t body = size - std::min<std::uintmax_t>(size, kHeaderBytes + kChecksumBytes);
+    if (metaSize > body || stateSize > body - metaSize || metaSize + stateSize != body)
+      throw refuse(fmt::format("sizes do not match the file (header: {} + {} bytes of content, file: {}): truncated or "
+                               "corrupted",
+                               metaSize, stateSize, body));
+    const std::uintmax_t memory = physicalMemoryBytes();
+    if (memory > 0 && size > memory / 2)
+      throw refuse(fmt::format("{} bytes, more than half of this machine's memory ({} bytes): not read", size, memory));
+  };
   const std::string bytes =
-      readInputFile(file, fmt::format("checkpoint {}", quotedPath(file)), kMaxCheckpointBytes);
+      readInputFile(file, fmt::format("checkpoint {}", quotedPath(file)), kMaxCheckpointBytes, kHeaderBytes, vet);
   return decodeCheckpoint(bytes, file);
 }
 

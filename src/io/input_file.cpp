@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cstring>
 
 #include "core/errors.hpp"
@@ -38,6 +39,12 @@ struct Descriptor {
 }  // namespace
 
 std::string readInputFile(const std::filesystem::path& path, const std::string& subject, std::uintmax_t maxBytes) {
+  return readInputFile(path, subject, maxBytes, 0, {});
+}
+
+std::string readInputFile(const std::filesystem::path& path, const std::string& subject, std::uintmax_t maxBytes,
+                          std::size_t headBytes,
+                          const std::function<void(std::string_view head, std::uintmax_t size)>& vet) {
   auto refuse = [&](const std::string& why) { return InputError(fmt::format("{}: {}", subject, why)); };
   // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer; it has no effect on
   // the regular files that are read.
@@ -48,17 +55,35 @@ std::string readInputFile(const std::filesystem::path& path, const std::string& 
   if (!S_ISREG(st.st_mode)) throw refuse(fmt::format("{}; a regular file is required", kindOf(st.st_mode)));
   const auto size = static_cast<std::uintmax_t>(st.st_size);
   if (size > maxBytes) throw refuse(fmt::format("{} bytes, more than the limit of {} bytes", size, maxBytes));
-  std::string content(static_cast<std::size_t>(size), '\0');
-  std::size_t done = 0;
-  while (done < content.size()) {
-    const ssize_t n = ::read(file.fd, content.data() + done, content.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw refuse(std::strerror(errno));
-    if (n == 0) break;  // shrank while being read: parse what is there
-    done += static_cast<std::size_t>(n);
+  auto readInto = [&](std::string& content, std::size_t from) {
+    std::size_t done = from;
+    while (done < content.size()) {
+      const ssize_t n = ::read(file.fd, content.data() + done, content.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw refuse(std::strerror(errno));
+      if (n == 0) break;  // shrank while being read: parse what is there
+      done += static_cast<std::size_t>(n);
+    }
+    content.resize(done);
+  };
+  std::string content;
+  std::size_t from = 0;
+  if (vet) {
+    content.assign(static_cast<std::size_t>(std::min<std::uintmax_t>(headBytes, size)), '\0');
+    readInto(content, 0);
+    vet(content, size);
+    from = content.size();
   }
-  content.resize(done);
+  content.resize(static_cast<std::size_t>(size), '\0');
+  readInto(content, from);
   return content;
+}
+
+std::uintmax_t physicalMemoryBytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long pageSize = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || pageSize <= 0) return 0;
+  return static_cast<std::uintmax_t>(pages) * static_cast<std::uintmax_t>(pageSize);
 }
 
 std::string printable(std::string_view text, std::size_t maxChars) {

@@ -3,6 +3,7 @@
 // limits, and echoing user values in error messages safely. docs/security.md lists the limits.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -32,6 +33,15 @@ std::string fileErrorMessage(const std::string& what, const std::filesystem::pat
 // "<subject>: <reason>", so `subject` names the key and the file, e.g.
 // `config error: sample.grading.file = "grains.csv"`.
 std::string readInputFile(const std::filesystem::path& path, const std::string& subject, std::uintmax_t maxBytes);
+// The same, in two steps: `vet(head, size)` sees the first headBytes (or fewer) and the file's size
+// before the rest is read, and throws to refuse it (e.g. sizes in a header that the file's length or
+// this machine's memory cannot hold), so a huge or sparse file is never read whole on trust.
+std::string readInputFile(const std::filesystem::path& path, const std::string& subject, std::uintmax_t maxBytes,
+                          std::size_t headBytes,
+                          const std::function<void(std::string_view head, std::uintmax_t size)>& vet);
+
+// Physical memory of this machine [bytes] (0 when the system does not say).
+std::uintmax_t physicalMemoryBytes();
 
 // A user's text as it may appear inside a one-line message: control characters and bytes that are
 // not UTF-8 escaped (\n, \x1b, \xff), cut to about maxChars characters with "...".

@@ -268,6 +268,39 @@ TEST(ValidateState, AcceptsASavedStateAndNamesWhatIsInconsistent) {
   EXPECT_NE(complaint([](Simulation& s) { s.box.upper(0).position = 1e6; }).find("far too large"), std::string::npos);
 }
 
+// A forged state (checksum recomputed, so only the loader stands between it and the engine): an
+// index or size that the loader used before checking it would write out of bounds (issue 28: a
+// contact index far beyond the particles crashed resume in buildIncidence). Every spoilt state is
+// saved and loaded again: the load must refuse it, and nothing may be derived from it first (under
+// AddressSanitizer an out-of-bounds access fails this test even if the error is thrown later).
+TEST(ValidateState, AForgedStateIsRefusedBeforeAnythingIsDerivedFromIt) {
+  const std::vector<std::pair<std::string, std::function<void(Simulation&)>>> spoils{
+      {"pair index far out of range", [](Simulation& s) { s.contacts.sphereSphere.a[0] = 4'000'000'000u; }},
+      {"second body far out of range", [](Simulation& s) { s.contacts.sphereSphere.b.back() = 4'000'000'000u; }},
+      {"wall index out of range", [](Simulation& s) { s.contacts.sphereWall.b[0] = 1'000'000u; }},
+      {"wall contact's particle out of range", [](Simulation& s) { s.contacts.sphereWall.a[0] = 3'000'000'000u; }},
+      {"fewer shapes than particles", [](Simulation& s) { s.particles.shape.resize(3); }},
+      {"fewer masses than particles", [](Simulation& s) { s.particles.mass.resize(1); }},
+      {"history shorter than the pairs", [](Simulation& s) { s.contacts.sphereSphere.history.pop_back(); }},
+      {"unknown shape", [](Simulation& s) { s.particles.shape[2] = static_cast<Shape>(7); }},
+      {"unknown wall control", [](Simulation& s) { s.box.walls[1].control = static_cast<WallControl>(9); }},
+      {"non-finite Young modulus", [](Simulation& s) { s.model.young = std::nan(""); }},
+      {"negative step count", [](Simulation& s) { s.stepCount = -5; }},
+      {"non-finite force", [](Simulation& s) { s.particles.force[0][2] = INFINITY; }},
+  };
+  ASSERT_GT(sheared().lab.simulation().contacts.sphereWall.size(), 0u);
+  for (const auto& [what, spoil] : spoils) {
+    lab::Laboratory source(smallConfig());
+    stateio::MemoryInput in(sheared().state);
+    source.loadState(in);
+    spoil(source.simulation());
+    const std::string forged = saved(source);
+    lab::Laboratory target(smallConfig());
+    stateio::MemoryInput forgedIn(forged);
+    EXPECT_ANY_THROW(target.loadState(forgedIn)) << what;
+  }
+}
+
 // --- the checkpoint container (io/checkpoint_file.hpp) ---------------------------------------------
 
 #include <xxhash.h>
