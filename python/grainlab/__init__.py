@@ -14,6 +14,7 @@ on a worker. docs/python.md describes every function."""
 import csv
 import glob
 import json
+import numbers
 import os
 import shutil
 import subprocess
@@ -260,6 +261,34 @@ class Result:
         return f"grainlab.Result({self.folder!r}, status={self.status!r})"
 
 
+# The most OpenMP threads any grainlab command accepts (solver.threads, --threads).
+MAX_THREADS = 1024
+
+
+def _threads(threads, name="threads"):
+    """threads as the program takes it: None for the config's solver.threads, else 1..MAX_THREADS.
+    0, negative, bool and non-integer values are refused (they used to mean "not given")."""
+    if threads is None:
+        return 0
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or not 1 <= threads <= MAX_THREADS:
+        raise ConfigError(f"{name} = {threads!r:.80}; allowed: None (the config's solver.threads) or an integer "
+                          f"in [1, {MAX_THREADS}]")
+    return int(threads)
+
+
+def _folder(out, name="out"):
+    """A results folder as given (str or os.PathLike), or None; an empty name is refused (it used to
+    mean "not given")."""
+    if out is None:
+        return None
+    path = os.fspath(out)
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)
+    if path == "":
+        raise ConfigError(f"{name} = '': must be a non-empty folder name (or None for the config's output.dir)")
+    return path
+
+
 def run(config, out=None, threads=None, progress=None, client=None, set=None, quiet=True):
     """Runs a test and returns its Result.
 
@@ -272,10 +301,11 @@ def run(config, out=None, threads=None, progress=None, client=None, set=None, qu
     client: a dask.distributed.Client: the run is one `grainlab run` of the installed program on a
     worker, its folder sent back to `out` (progress is not reported)."""
     cfg = _config(config, set)
+    out = _folder(out)
+    threads = _threads(threads)
     if client is not None:
         return _run_on_client(cfg, out, threads, client)
-    folder = _grainlab.run(cfg._native, "" if out is None else os.fspath(out), int(threads or 0), bool(quiet),
-                           progress)
+    folder = _grainlab.run(cfg._native, "" if out is None else out, threads, bool(quiet), progress)
     return Result(folder)
 
 
@@ -358,6 +388,10 @@ def sweep(config, vary, out=None, client=None, set=None, jobs=None, threads=None
     dask.distributed.Client whose scheduler runs the cases (`--scheduler`), else local processes,
     `jobs` at a time. Returns a SweepResult; raises ConfigError for a refused config or vary."""
     cfg = _config(config, set)
+    out = _folder(out)
+    threads = _threads(threads)
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral) or not 1 <= jobs <= 4096):
+        raise ConfigError(f"jobs = {jobs!r:.80}; allowed: None or an integer in [1, 4096]")
     if not isinstance(vary, dict) or not vary:
         raise ConfigError(f"sweep: vary = {vary!r:.80}; allowed: a non-empty dict {{key: [values]}}")
     with tempfile.TemporaryDirectory(prefix="grainlab-") as scratch:
@@ -404,7 +438,7 @@ class Simulation(_grainlab.Simulation):
     def __init__(self, config, set=None, threads=None, progress=None):
         cfg = _config(config, set)
         self.config = cfg
-        super().__init__(cfg._native, int(threads or 0), progress)
+        super().__init__(cfg._native, _threads(threads), progress)
 
     @property
     def p(self):

@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 #include <fmt/format.h>
 
 #include "cli/commands.hpp"
+#include "cli/thread_count.hpp"
 #include "core/contact_view.hpp"
 #include "core/errors.hpp"
 #include "io/config.hpp"
@@ -211,9 +213,10 @@ class PySimulation {
         observer_(std::make_unique<PythonObserver>(std::move(progress))) {
     const lab::RunConfig& rc = config_->resolved;
     lab_ = std::make_unique<lab::Laboratory>(rc, observer_->function());
+    warnIfForked();
     {
       py::gil_scoped_release release;
-      omp_set_num_threads(threads_);
+      cli::setOpenMPThreads(threads_);
       try {
         std::optional<Simulation> packed = cli::loadInputFiles(rc);
         prep_ = packed ? lab_->adoptPacking(std::move(*packed)) : lab_->prepare();
@@ -225,25 +228,57 @@ class PySimulation {
     resetReference();
   }
 
-  Simulation& sim() { return lab_->simulation(); }
-  const Simulation& sim() const { return lab_->simulation(); }
+  // The engine, for every method and property: refused while step() runs in another Python thread
+  // (step releases the GIL, so another thread could otherwise change or read the arrays mid-step:
+  // issue 28 saw "double free or corruption" and lost steps). The flag is set and tested with the
+  // GIL held, so the test and the set cannot interleave.
+  Simulation& sim() {
+    checkIdle();
+    return lab_->simulation();
+  }
+  const Simulation& sim() const {
+    checkIdle();
+    return lab_->simulation();
+  }
+  void checkIdle() const {
+    if (busy_.load(std::memory_order_acquire))
+      throw std::runtime_error(
+          "this grainlab.Simulation is stepping in another thread: one Simulation is driven by one thread at a time "
+          "(wait for step() to return, or give each thread its own Simulation)");
+  }
 
   // Steps n times with the GIL released; every kChunk steps takes the GIL to let Python handle
   // Ctrl-C (KeyboardInterrupt, the state then being that after a whole step).
   void step(long n) {
     if (n < 0) throw py::value_error(fmt::format("step: n = {}; allowed: n >= 0", n));
+    checkIdle();
+    warnIfForked();
+    struct Busy {
+      std::atomic<bool>& flag;
+      explicit Busy(std::atomic<bool>& f) : flag(f) { flag.store(true, std::memory_order_release); }
+      ~Busy() { flag.store(false, std::memory_order_release); }
+    } busy(busy_);
+    Simulation& engine = lab_->simulation();
     constexpr long kChunk = 1000;
     long done = 0;
     while (done < n) {
       const long chunk = std::min(kChunk, n - done);
       {
         py::gil_scoped_release release;
-        omp_set_num_threads(threads_);
-        for (long k = 0; k < chunk; ++k) sim().step();
+        cli::setOpenMPThreads(threads_);
+        for (long k = 0; k < chunk; ++k) engine.step();
       }
       done += chunk;
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     }
+  }
+
+  // A process forked after OpenMP teams ran steps on one thread (cli/thread_count.hpp): said once.
+  void warnIfForked() {
+    if (warnedFork_ || threads_ <= 1 || !cli::forkedAfterOpenMPTeams()) return;
+    warnedFork_ = true;
+    const std::string text = cli::forkedThreadsWarning(threads_);
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1) != 0) throw py::error_already_set();
   }
 
   // The state the strains are measured from: the current one.
@@ -331,6 +366,8 @@ class PySimulation {
   lab::PreparationResult prep_;
   Vec3 lengths0_ = Vec3::Ones();
   double volume0_ = 1.0;
+  mutable std::atomic<bool> busy_{false};
+  bool warnedFork_ = false;
 };
 
 py::array vec3View(std::vector<Vec3>& v, py::handle owner, bool writeable) {

@@ -89,14 +89,15 @@ int runBench(const BenchOptions& opt) {
     throw InputError(fmt::format("bench scene \"{}\" is unknown; available: triaxial-iso, lattice", opt.scene));
   if (opt.particles < 10) throw InputError(fmt::format("--particles = {}: must be >= 10", opt.particles));
   if (opt.steps < 1) throw InputError(fmt::format("--steps = {}: must be >= 1", opt.steps));
-  if (opt.threads < 1) throw InputError(fmt::format("--threads = {}: must be >= 1", opt.threads));
+  if (opt.threads < 1 || opt.threads > kMaxThreads)
+    throw InputError(fmt::format("--threads = {}: must be in [1, {}]", opt.threads, kMaxThreads));
   lab::RunConfig config = benchConfig(opt.particles);
   if (!opt.config.empty()) config = io::parseConfig(io::loadConfigTable(opt.config), io::configBaseDir(opt.config));
   const fs::path cache = cacheFile(opt.scene, opt.particles);
   const std::string scene = opt.packing.empty() ? opt.scene : "packing";
 
   Simulation sim;
-  omp_set_num_threads(std::max(2, opt.threads));  // preparation uses what is there
+  setOpenMPThreads(std::max(2, opt.threads));  // preparation uses what is there
   if (!opt.packing.empty()) {
     // Any packing (a run's packing.txt, another program's sample converted): its grains, shapes and
     // boundary as they are, held at the config's pressure by its walls or cell.
@@ -120,7 +121,7 @@ int runBench(const BenchOptions& opt) {
   // A benchmark times the threads it is asked for, but says when other processes share the cores.
   const ThreadChoice choice = chooseThreads(opt.threads, /*adapt=*/false);
   if (!choice.warning.empty()) fmt::print(stderr, "{}\n", choice.warning);
-  omp_set_num_threads(opt.threads);
+  setOpenMPThreads(opt.threads);
   for (int i = 0; i < 200; ++i) sim.step();  // rebuild contacts and their history
   const long buildsBefore = sim.broadPhase.builds;
   const auto t0 = std::chrono::steady_clock::now();

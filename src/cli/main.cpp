@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
+#include "cli/thread_count.hpp"
 #include "core/errors.hpp"
 #include "io/input_file.hpp"
 #include "io/presets.hpp"
@@ -17,6 +18,16 @@ namespace {
 // Every error is one line on stderr, whatever bytes a value or path in it had (the values in a
 // message are cut already; this bounds the whole).
 std::string oneLine(const std::string& message) { return grainlab::io::printable(message, 600); }
+
+// An option's value may not be empty: "--out ''" used to mean "not given" (the config's output.dir),
+// "--scheduler ''" a local sweep. Refused with the option's name.
+const CLI::Validator kNonEmpty(
+    [](std::string& value) {
+      return value.empty() ? std::string("an empty value is not allowed (leave the option out instead)") : std::string();
+    },
+    "NON-EMPTY");
+// Thread counts: the same range as solver.threads.
+const CLI::Validator kThreadRange = CLI::Range(1, grainlab::cli::kMaxThreads);
 
 }  // namespace
 
@@ -28,8 +39,8 @@ int main(int argc, char** argv) {
 
   cli::RunOptions run;
   auto* runCmd = app.add_subcommand("run", "Run a laboratory test from a TOML config or preset:NAME");
-  runCmd->add_option("config", run.config, "CONFIG.toml or preset:NAME")->required();
-  runCmd->add_option("--out", run.outDir, "results folder (overrides output.dir)");
+  runCmd->add_option("config", run.config, "CONFIG.toml or preset:NAME")->check(kNonEmpty)->required();
+  runCmd->add_option("--out", run.outDir, "results folder (overrides output.dir)")->check(kNonEmpty);
   runCmd->add_option("--set", run.overrides, "override a config key: KEY=VALUE (TOML value)")
       ->allow_extra_args(false);
   runCmd->add_option("--threads", run.threads, "OpenMP threads (overrides solver.threads); fewer when other processes keep the cores busy (a warning says so; GRAINLAB_KEEP_THREADS=1 keeps them)")
@@ -40,38 +51,39 @@ int main(int argc, char** argv) {
 
   cli::ResumeOptions resume;
   auto* resumeCmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
-  resumeCmd->add_option("dir", resume.dir, "results folder of the run")->required();
+  resumeCmd->add_option("dir", resume.dir, "results folder of the run")->check(kNonEmpty)->required();
   resumeCmd->add_flag("--quiet", resume.quiet, "no progress output");
   resumeCmd->add_flag("--allow-older-version", resume.allowOlderVersion,
                       "accept a checkpoint written by an older grainlab (same checkpoint format)");
 
   cli::SweepOptions sweep;
   auto* sweepCmd = app.add_subcommand("sweep", "Run a grid of overrides in parallel processes and compare them");
-  sweepCmd->add_option("config", sweep.config, "CONFIG.toml or preset:NAME")->required();
+  sweepCmd->add_option("config", sweep.config, "CONFIG.toml or preset:NAME")->check(kNonEmpty)->required();
   sweepCmd->add_option("--vary", sweep.vary, "KEY=V1,V2,... (repeat for a grid)")->required()->allow_extra_args(false);
   sweepCmd->add_option("--set", sweep.overrides, "override applied to every case")->allow_extra_args(false);
   sweepCmd->add_option("--jobs", sweep.jobs, "cases run at once")->capture_default_str();
-  sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)");
-  sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)");
+  sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)")
+      ->check(kThreadRange);
+  sweepCmd->add_option("--out", sweep.outDir, "folder of the sweep (default runs/sweep)")->check(kNonEmpty);
   sweepCmd->add_flag("--quiet", sweep.quiet, "no progress output");
   auto* schedulerOpt =
-      sweepCmd->add_option("--scheduler", sweep.scheduler, "run the cases on this Dask scheduler (tcp://HOST:PORT)");
+      sweepCmd->add_option("--scheduler", sweep.scheduler, "run the cases on this Dask scheduler (tcp://HOST:PORT)")->check(kNonEmpty);
   sweepCmd->add_flag("--shared-out", sweep.sharedOut, "with --scheduler: every worker sees --out at the same path")
       ->needs(schedulerOpt);
 
   cli::CalibrateOptions calibrate;
   auto* calibrateCmd = app.add_subcommand("calibrate", "Fit micro-parameters to laboratory values and curves");
-  calibrateCmd->add_option("config", calibrate.config, "CONFIG.toml or preset:NAME")->required();
-  calibrateCmd->add_option("--target", calibrate.target, "TARGET.toml: parameters, targets, optimiser")->required();
+  calibrateCmd->add_option("config", calibrate.config, "CONFIG.toml or preset:NAME")->check(kNonEmpty)->required();
+  calibrateCmd->add_option("--target", calibrate.target, "TARGET.toml: parameters, targets, optimiser")->check(kNonEmpty)->required();
   calibrateCmd->add_option("--jobs", calibrate.jobs, "runs at once (default: [execution] jobs, else the cores)")
       ->check(CLI::PositiveNumber);
-  calibrateCmd->add_option("--scheduler", calibrate.scheduler, "run on this Dask scheduler (tcp://HOST:PORT)");
-  calibrateCmd->add_option("--out", calibrate.outDir, "calibration folder (default runs/calibration); rerun to resume");
+  calibrateCmd->add_option("--scheduler", calibrate.scheduler, "run on this Dask scheduler (tcp://HOST:PORT)")->check(kNonEmpty);
+  calibrateCmd->add_option("--out", calibrate.outDir, "calibration folder (default runs/calibration); rerun to resume")->check(kNonEmpty);
   calibrateCmd->add_flag("--quiet", calibrate.quiet, "no progress output");
 
   cli::RunOptions check;
   auto* checkCmd = app.add_subcommand("check", "Validate a config and print it with every default filled in");
-  checkCmd->add_option("config", check.config, "CONFIG.toml or preset:NAME")->required();
+  checkCmd->add_option("config", check.config, "CONFIG.toml or preset:NAME")->check(kNonEmpty)->required();
   checkCmd->add_option("--set", check.overrides, "override a config key: KEY=VALUE (TOML value)")
       ->allow_extra_args(false);
 
@@ -80,18 +92,18 @@ int main(int argc, char** argv) {
   benchCmd->add_option("scene", bench.scene, "scene name (triaxial-iso)")->capture_default_str();
   benchCmd->add_option("--particles", bench.particles, "number of particles")->capture_default_str();
   benchCmd->add_option("--steps", bench.steps, "timed steps")->capture_default_str();
-  benchCmd->add_option("--threads", bench.threads, "OpenMP threads")->capture_default_str();
+  benchCmd->add_option("--threads", bench.threads, "OpenMP threads")->capture_default_str()->check(kThreadRange);
   benchCmd->add_flag("--json", bench.json, "print one JSON object");
   benchCmd->add_option("--packing", bench.packing,
                        "time this packing file (walls or periodic cell, spheres or ellipsoids) held at the "
-                       "config's confining pressure, instead of a scene");
+                       "config's confining pressure, instead of a scene")->check(kNonEmpty);
   benchCmd->add_option("--config", bench.config,
                        "with --packing: CONFIG.toml or preset:NAME giving the contact law, damping and pressure "
-                       "(default: the [W] law at 100 kPa)");
+                       "(default: the [W] law at 100 kPa)")->check(kNonEmpty);
 
   cli::AnalyseOptions analyse;
   auto* analyseCmd = app.add_subcommand("analyse", "Micromechanics of a finished run, from its snapshots (DIR/micro)");
-  analyseCmd->add_option("dir", analyse.dir, "results folder of the run")->required();
+  analyseCmd->add_option("dir", analyse.dir, "results folder of the run")->check(kNonEmpty)->required();
   analyseCmd->add_option("--classes", analyse.classDivisions, "N: 24*N^2 orientation classes")->capture_default_str();
   analyseCmd->add_flag("--fourth-order", analyse.fourthOrder, "also the fourth-order anisotropies");
   analyseCmd->add_flag("--no-plots", [&](std::int64_t) { analyse.plots = false; }, "skip the pictures");

@@ -1,8 +1,11 @@
 #include "cli/thread_count.hpp"
 
+#include <omp.h>
+#include <pthread.h>
 #include <sched.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -51,9 +54,47 @@ int usableCores() {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
+namespace {
+
+std::atomic<bool> teamsStarted{false};
+std::atomic<bool> forkedAfterTeams{false};
+
+// In the child of a fork (async-signal-safe: only atomics).
+void afterForkInChild() {
+  if (teamsStarted.load(std::memory_order_relaxed)) forkedAfterTeams.store(true, std::memory_order_relaxed);
+}
+
+const bool kForkHandlerRegistered = [] { return ::pthread_atfork(nullptr, nullptr, &afterForkInChild) == 0; }();
+
+}  // namespace
+
+void setOpenMPThreads(int threads) {
+  if (forkedAfterTeams.load(std::memory_order_relaxed)) threads = 1;
+  if (threads > 1) teamsStarted.store(true, std::memory_order_relaxed);
+  omp_set_num_threads(std::max(1, threads));
+}
+
+bool forkedAfterOpenMPTeams() {
+  (void)kForkHandlerRegistered;
+  return forkedAfterTeams.load(std::memory_order_relaxed);
+}
+
+std::string forkedThreadsWarning(int requested) {
+  return fmt::format(
+      "grainlab: warning: this process was forked after OpenMP threads had run (libgomp's threads do not survive "
+      "fork): running on 1 thread instead of {}; start processes with multiprocessing's \"spawn\" or "
+      "\"forkserver\" method to use more (results do not depend on the thread count)",
+      requested);
+}
+
 ThreadChoice chooseThreads(int requested, bool adapt) {
   ThreadChoice c;
   c.threads = requested;
+  if (requested > 1 && forkedAfterOpenMPTeams()) {
+    c.threads = 1;
+    c.warning = forkedThreadsWarning(requested);
+    return c;
+  }
   if (requested <= 1) return c;
   const std::optional<int> others = otherRunnableTasks();
   if (!others) return c;

@@ -7,6 +7,9 @@
 
 namespace grainlab::cli {
 
+// The most OpenMP threads any command accepts (solver.threads, --threads of run, sweep and bench).
+inline constexpr int kMaxThreads = 1024;
+
 // Runnable tasks of other processes right now: the median of a few samples of /proc/stat's
 // procs_running (which counts this process' own running thread, subtracted). Nothing where
 // /proc/stat cannot be read.
@@ -23,6 +26,18 @@ struct ThreadChoice {
 // `requested` threads, or as many as the free cores when other processes keep cores busy; with
 // adapt = false, or the environment variable GRAINLAB_KEEP_THREADS=1, `requested` is kept and
 // only the warning says so.
+// In a process forked after OpenMP teams of more than one thread had run (Python's multiprocessing
+// with the "fork" start method), also 1 thread with a warning: libgomp's threads do not survive
+// fork, and a team of two or more in the child waits forever for them (a team of one works).
 ThreadChoice chooseThreads(int requested, bool adapt = true);
+
+// Sets OpenMP's thread count for the next parallel regions and remembers whether teams of more than
+// one thread ran in this process (what a fork must know). Every omp_set_num_threads of the program
+// and the Python module goes through here.
+void setOpenMPThreads(int threads);
+// Whether this process is a child forked after teams of more than one thread had run.
+bool forkedAfterOpenMPTeams();
+// The warning chooseThreads gives in such a child (for the Python module's warnings.warn).
+std::string forkedThreadsWarning(int requested);
 
 }  // namespace grainlab::cli
