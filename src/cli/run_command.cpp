@@ -8,8 +8,11 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <random>
+#include <string_view>
 #include <sstream>
 #include <nlohmann/json.hpp>
+#include <xxhash.h>
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
@@ -141,6 +144,35 @@ int checkConfig(const RunOptions& opt) {
 }
 
 namespace {
+
+// The status of a run whose curves and summary are written but whose plots and micromechanics
+// analysis are not yet (summary.json "status"); "completed" is written last.
+constexpr const char* kFinishing = "finishing";
+
+// The analysis of the run's snapshots (micro/analysis.*, class averages, rose diagrams) as
+// `grainlab analyse DIR` makes it; a failure there leaves the run's results complete.
+void analyseMicro(const fs::path& dir, bool plots) {
+  AnalyseOptions a;
+  a.dir = dir.string();
+  a.plots = plots;
+  a.quiet = true;
+  try {
+    runAnalyse(a);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "grainlab: warning: micromechanics analysis failed (%s); the results are complete without it\n",
+                 e.what());
+  }
+}
+
+// From "finishing" to "completed": plots, the micromechanics analysis, the folder's manifest, and
+// last the summary that says "completed". Also what `resume` does for a run killed in between.
+void completeResults(const fs::path& dir, const lab::RunConfig& config, json& summary, bool quiet, bool micro) {
+  if (config.output.plots) makePlots(dir, quiet);
+  if (micro) analyseMicro(dir, config.output.plots);
+  summary["status"] = "completed";
+  io::RunFolder::writeManifest(dir);
+  io::writeFileAtomic(dir / "summary.json", jsonText(summary));
+}
 
 // The part of a run after the sample exists: shearing (resumable), results, plots. Shared by
 // `run` and `resume`; `summary` already holds what preparation reported.
@@ -343,13 +375,14 @@ class RunSession {
     // The particles simulated (a packing file brings its own number, whatever sample.n_particles says).
     summary_["particle_steps_per_s"] =
         static_cast<double>(steps) * static_cast<double>(lab_.simulation().particles.size()) / wall;
-    summary_["status"] = "completed";
+    // "finishing" until the plots and the micromechanics analysis are written too: a run killed
+    // while plotting is not reported complete, and `resume` finishes what is missing.
+    summary_["status"] = kFinishing;
     io::TimeseriesColumns columns = io::timeseriesColumns(config_);
     columns.micro = lab_.microColumnNames();
     io::writeFileAtomic(dir_ / "timeseries.csv", io::timeseriesCsv(records, columns));
     io::writeFileAtomic(dir_ / "summary.json", jsonText(summary_));
-    if (config_.output.plots) makePlots(dir_, quiet_);
-    if (!micro_.snapshots().empty()) analyseMicro();
+    completeResults(dir_, config_, summary_, quiet_, !micro_.snapshots().empty());
     if (!quiet_) {
       if (summary_.contains("G_MPa"))
         std::printf("phi_peak = %.2f deg at gamma = %.4f, phi_res = %.2f deg, psi_max = %s deg, G = %.1f MPa\n",
@@ -377,21 +410,6 @@ class RunSession {
     out["energy_residual"] = std::isfinite(r.energyResidual) ? json(r.energyResidual) : json(nullptr);
     out["eps1"] = r.eps1;
     return out;
-  }
-
-  // The analysis of the run's snapshots (micro/analysis.*, class averages, rose diagrams) as
-  // `grainlab analyse DIR` makes it; a failure there leaves the run's results complete.
-  void analyseMicro() {
-    AnalyseOptions a;
-    a.dir = dir_.string();
-    a.plots = config_.output.plots;
-    a.quiet = true;
-    try {
-      runAnalyse(a);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "grainlab: warning: micromechanics analysis failed (%s); the results are complete without it\n",
-                   e.what());
-    }
   }
 
   const lab::RunConfig& config_;
@@ -444,8 +462,58 @@ int inFolder(io::RunFolder& folder, const std::function<int()>& body) {
 static void useThreads(int requested) {
   const ThreadChoice choice = chooseThreads(requested);
   if (!choice.warning.empty()) std::fprintf(stderr, "%s\n", choice.warning.c_str());
-  omp_set_num_threads(choice.threads);
+  setOpenMPThreads(choice.threads);
 }
+
+namespace {
+
+// A new run's identity (128 random bits, hex): in config.resolved.toml's first line, the summary and
+// every checkpoint, so that `resume` continues a checkpoint only in the folder of its own run. It
+// does not enter the simulation.
+std::string newRunId() {
+  std::random_device rd;
+  std::string id;
+  for (int k = 0; k < 4; ++k) id += fmt::format("{:08x}", static_cast<std::uint32_t>(rd()));
+  return id;
+}
+
+constexpr std::string_view kRunIdPrefix = "# grainlab run ";
+
+// The run id in the first line of a config.resolved.toml ("" for a file without one).
+std::string runIdOf(const fs::path& resolvedConfig) {
+  const std::string text = io::readInputFile(resolvedConfig, "resume: config.resolved.toml", io::kMaxConfigBytes);
+  if (text.compare(0, kRunIdPrefix.size(), kRunIdPrefix) != 0) return "";
+  const auto end = text.find_first_of(" \n", kRunIdPrefix.size());
+  return text.substr(kRunIdPrefix.size(), end == std::string::npos ? std::string::npos : end - kRunIdPrefix.size());
+}
+
+std::string xxh64Hex(std::string_view bytes) { return fmt::format("{:016x}", XXH64(bytes.data(), bytes.size(), 0)); }
+
+// What binds a checkpoint to the folder it is resumed in: the run id of config.resolved.toml and the
+// packing the run saved there. A config and checkpoint copied from another run's folder (the folder
+// then mixing the packing of one run with the results of another) are refused.
+void checkCheckpointBelongsToFolder(const json& checkpointSummary, const fs::path& dir, const fs::path& stateFile) {
+  auto refuse = [&](const std::string& why) {
+    return InputError(fmt::format("checkpoint {}: {}; a checkpoint resumes only in the results folder of its own run",
+                                  io::quotedPath(stateFile), why));
+  };
+  const std::string folderId = runIdOf(dir / "config.resolved.toml");
+  const std::string id = checkpointSummary.value("run_id", std::string());
+  if (id != folderId)
+    throw refuse(fmt::format("belongs to run {} but config.resolved.toml beside it is of run {}", id.empty() ? "(none)" : id,
+                             folderId.empty() ? "(none)" : folderId));
+  const std::string packing = checkpointSummary.value("packing_xxh64", std::string());
+  if (!packing.empty()) {
+    std::error_code ec;
+    if (!fs::exists(dir / "packing.txt", ec)) throw refuse("the run saved packing.txt, which is not in the folder any more");
+    const std::string actual =
+        xxh64Hex(io::readInputFile(dir / "packing.txt", "resume: packing.txt", io::kMaxPackingBytes));
+    if (actual != packing)
+      throw refuse(fmt::format("packing.txt in the folder (xxh64 {}) is not the one the run saved (xxh64 {})", actual, packing));
+  }
+}
+
+}  // namespace
 
 int runLab(const RunOptions& opt) { return runResolved(resolveConfig(opt), opt, {}); }
 
@@ -456,9 +524,12 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
   io::RunFolder folder = io::RunFolder::forRun(config.output.dir);
   return inFolder(folder, [&] {
     const fs::path dir = folder.work();
-    io::writeFileAtomic(dir / "config.resolved.toml", io::toTomlString(io::resolvedTable(config)));
+    const std::string runId = newRunId();
+    io::writeFileAtomic(dir / "config.resolved.toml",
+                        fmt::format("{}{}\n", kRunIdPrefix, runId) + io::toTomlString(io::resolvedTable(config)));
 
     json summary;
+    summary["run_id"] = runId;
     summary["config_source"] = opt.config;
     summary["n_particles"] = packed ? packed->particles.size() : static_cast<std::size_t>(config.sample.nParticles);
     summary["confining_pressure"] = config.test.confiningPressure;
@@ -471,13 +542,14 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
       const lab::PreparationResult prep = packed ? lab.adoptPacking(std::move(*packed)) : lab.prepare();
       session.progress().finish();
       const Simulation& sim = lab.simulation();
-      if (config.output.savePacking)
-        io::writeFileAtomic(
-            dir / "packing.txt",
-            io::packingText(io::packingFromSimulation(
-                sim, fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}", prep.e0,
-                                 config.test.confiningPressure, config.sample.seed))));
       json& s = session.summary();
+      if (config.output.savePacking) {
+        const std::string text = io::packingText(io::packingFromSimulation(
+            sim, fmt::format("grainlab prepared sample: e = {:.5f}, p = {} Pa, seed {}", prep.e0,
+                             config.test.confiningPressure, config.sample.seed)));
+        io::writeFileAtomic(dir / "packing.txt", text);
+        s["packing_xxh64"] = xxh64Hex(text);
+      }
       s["n_particles"] = sim.particles.size();
       s["e0"] = finite(prep.e0, "e0");
       // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
@@ -545,12 +617,28 @@ int resumeLab(const ResumeOptions& opt) {
   if (!fs::exists(dir / "config.resolved.toml", ec))
     throw InputError(fmt::format("resume {}: no config.resolved.toml there (not a grainlab results folder)",
                                  io::quotedPath(opt.dir)));
-  if (!folder.staged() && fs::exists(dir / "summary.json", ec)) {
-    const json done = json::parse(io::readInputFile(dir / "summary.json", "resume: summary.json", io::kMaxConfigBytes),
-                                  nullptr, false);
-    if (done.is_object() && done.value("status", "") == "completed") {
-      if (!opt.quiet) std::printf("%s: run already completed\n", io::printable(dir.native(), 240).c_str());
+  if (fs::exists(dir / "summary.json", ec)) {
+    json done = json::parse(io::readInputFile(dir / "summary.json", "resume: summary.json", io::kMaxConfigBytes),
+                            nullptr, false);
+    const std::string status = done.is_object() && done.contains("status") && done["status"].is_string()
+                                   ? done["status"].get<std::string>() : std::string();
+    if (status == "completed") {
+      // A re-run killed after completing but before its results were put in place: put them there.
+      if (folder.staged()) inFolder(folder, [] { return 0; });
+      if (!opt.quiet) std::printf("%s: run already completed\n", io::printable(folder.target().native(), 240).c_str());
       return 0;
+    }
+    if (status == kFinishing) {
+      // Killed while plotting or analysing: the curves and summary are there, finish the rest.
+      RunOptions resolved;
+      resolved.config = (dir / "config.resolved.toml").string();
+      const lab::RunConfig config = resolveConfig(resolved);
+      return inFolder(folder, [&] {
+        completeResults(dir, config, done, opt.quiet, fs::exists(dir / "micro" / "snapshots.csv", ec));
+        if (!opt.quiet)
+          std::printf("%s: plots and analysis finished; run completed\n", io::printable(folder.target().native(), 240).c_str());
+        return 0;
+      });
     }
   }
   if (!fs::exists(stateFile, ec))
@@ -562,6 +650,7 @@ int resumeLab(const ResumeOptions& opt) {
   const lab::RunConfig config = resolveConfig(resolved);
   const io::Checkpoint checkpoint = io::readCheckpointFile(stateFile);
   io::checkCheckpointBelongs(checkpoint, stateFile, config, opt.allowOlderVersion);
+  checkCheckpointBelongsToFolder(checkpoint.record["summary"], dir, stateFile);
   useThreads(config.solver.threads);
   const json& record = checkpoint.record;
   // Checkpoints of runs before the micromechanics snapshots have no list: the run numbers from 0.

@@ -8,9 +8,16 @@
 //     killed re-run leaves NAME exactly as it was; `grainlab resume NAME` continues a killed re-run
 //     from its sibling, and the next `run` into NAME discards it.
 //   - Any other non-empty folder is refused: grainlab replaces only its own results.
+//   - Files a user added to a results folder (not listed in its manifest, .grainlab-manifest, which a
+//     completed run writes last) are kept: a re-run moves them into the new results.
+//   - One run at a time: a run or resume holds an exclusive lock (flock) on the results folder for
+//     its whole life; a second one into the same folder is refused (InputError) and touches nothing.
 //
 // A symbolic link as the folder is followed (the results replace its target's contents).
 #include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace grainlab::io {
 
@@ -39,9 +46,24 @@ class RunFolder {
   // .NAME.grainlab-new beside NAME.
   static std::filesystem::path stagingFolderOf(const std::filesystem::path& target);
 
+  // The manifest of a completed run: the names of the top-level entries the run wrote.
+  static constexpr const char* kManifest = ".grainlab-manifest";
+  // Writes the manifest of a run's folder (every entry in it now, and the manifest itself).
+  static void writeManifest(const std::filesystem::path& dir);
+
  private:
   std::filesystem::path target_, work_;
   enum class Origin { Created, WasEmpty, Staged, Resumed } origin_ = Origin::Created;
+  std::shared_ptr<int> lock_;  // the flock'd descriptor of the target folder, closed with the last copy
+  // Takes the folder's lock or throws InputError naming it.
+  void lock();
+  // After the exchange: moves what a user had added to the earlier results (now in work_) into the
+  // new ones.
+  void keepUserFiles() const;
 };
+
+// The entries of a results folder that a user added: not in its manifest (for a folder without one,
+// an earlier grainlab's or a killed run's, not one of the names grainlab writes).
+std::vector<std::string> userEntries(const std::filesystem::path& dir);
 
 }  // namespace grainlab::io

@@ -348,6 +348,7 @@ def resumable(tmp_path_factory):
     proc = subprocess.run([GRAINLAB, "run", str(base / "c.toml"), "--out", str(base / "run"), "--quiet"],
                           capture_output=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
+    (base / "run" / ".grainlab-manifest").unlink()
     return base / "run"
 
 
@@ -429,3 +430,59 @@ def test_fuzz_unwritable_output_folders(tmp_path):
     summary_free = [p for p in os.listdir(tmp_path) if p not in ("c.toml", "file")]
     assert summary_free == []
     assert json.dumps(sorted(os.listdir(tmp_path))) == json.dumps(["c.toml", "file"])
+
+
+def _forge(good, state_part_edit):
+    """The checkpoint with its state bytes edited and the checksum recomputed, as a forger would."""
+    import xxhash
+    meta = int.from_bytes(good[64:72], "little")
+    start = 80 + meta
+    data = bytearray(good[:-8])
+    state_part_edit(data, start, len(data))
+    return bytes(data) + xxhash.xxh64(bytes(data), seed=0).intdigest().to_bytes(8, "little")
+
+
+def test_fuzz_forged_checkpoints(resumable, tmp_path):
+    """Checkpoints edited inside the engine state with the checksum recomputed (issue 28: a contact
+    index read from such a file crashed resume). The checksum cannot catch these; the loader must:
+    exit 2 naming the file, or (a forged state that is consistent) a run that ends normally or fails
+    with exit 1, never a signal, a hang or a non-finite result."""
+    rng = random.Random(f"{SEED}-forged")
+    good = (resumable / "checkpoint" / "state.bin").read_bytes()
+    folder = tmp_path / "run"
+    counts = {0: 0, 1: 0, 2: 0}
+    for i in range(60 * SCALE):
+        kind = rng.choice(["bytes", "word", "index"])
+
+        def edit(data, start, end):
+            if kind == "bytes":
+                for _ in range(rng.randrange(1, 8)):
+                    data[rng.randrange(start, end)] = rng.randrange(256)
+            elif kind == "word":  # a 64-bit count or value overwritten
+                pos = rng.randrange(start, end - 8)
+                data[pos:pos + 8] = rng.choice([b"\xff" * 8, b"\x00" * 8, (2**31).to_bytes(8, "little"),
+                                                rng.randbytes(8)])
+            else:  # a 32-bit index far out of range
+                pos = rng.randrange(start, end - 4)
+                data[pos:pos + 4] = rng.choice([4_000_000_000, 1_000_000, 2**31 - 1, 150]).to_bytes(4, "little")
+        forged = _forge(good, edit)
+        if folder.exists():
+            shutil.rmtree(folder)
+        shutil.copytree(resumable, folder)
+        (folder / "summary.json").unlink()
+        (folder / "timeseries.csv").unlink()
+        (folder / "checkpoint" / "state.bin").write_bytes(forged)
+        try:
+            proc = subprocess.run([GRAINLAB, "resume", str(folder), "--quiet"], capture_output=True, timeout=60)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"hang: forged checkpoint case {i} ({kind})")
+        case = f"forged checkpoint case {i} ({kind}, seed {SEED})"
+        assert proc.returncode >= 0, f"signal {-proc.returncode}: {case}"
+        assert proc.returncode in (0, 1, 2), f"exit {proc.returncode}: {case}"
+        counts[proc.returncode] += 1
+        if proc.returncode == 2:
+            assert_refused(proc, ["state.bin"], case)
+        elif proc.returncode == 0:
+            text = (folder / "summary.json").read_text()
+            assert "NaN" not in text and "Infinity" not in text, case
+    assert counts[2] > 0  # most forgeries are refused by the loader's checks

@@ -11,7 +11,7 @@ from conftest import GRAINLAB
 SETS = ["--set", "sample.n_particles=150", "--set", "test.final_axial_strain=0.03",
         "--set", "output.checkpoint_every=0.004", "--set", "output.vtk_every_strain=0.01",
         "--set", "output.plots=false", "--threads", "2", "--quiet"]
-VOLATILE = {"wall_seconds", "particle_steps_per_s"}
+VOLATILE = {"wall_seconds", "particle_steps_per_s", "run_id"}
 
 
 def outputs(out):
