@@ -91,9 +91,12 @@ def test_run_equals_the_cli_bit_for_bit(tmp_path):
     assert result.status == "completed"
     assert without(result.summary, VOLATILE) == without(expected, VOLATILE)
     assert (tmp_path / "py" / "timeseries.csv").read_bytes() == (tmp_path / "cli" / "timeseries.csv").read_bytes()
-    # The resolved configs differ only in output.dir.
-    assert (tmp_path / "py" / "config.resolved.toml").read_text().replace(str(tmp_path / "py"), "OUT") == \
-        (tmp_path / "cli" / "config.resolved.toml").read_text().replace(str(tmp_path / "cli"), "OUT")
+    # The resolved configs differ only in output.dir (and the run id of their first line).
+    def resolved(folder):
+        lines = (folder / "config.resolved.toml").read_text().replace(str(folder), "OUT").splitlines()
+        assert lines[0].startswith("# grainlab run ")
+        return lines[1:]
+    assert resolved(tmp_path / "py") == resolved(tmp_path / "cli")
     # The time series as numpy: integers stay integers, the values are the CSV's.
     ts = result.timeseries
     assert ts["step"].dtype == np.int64
