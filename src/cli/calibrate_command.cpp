@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/study_folder.hpp"
 #include "cli/sweep_dask.hpp"
 #include "io/install_paths.hpp"
 #include "core/errors.hpp"
@@ -475,7 +476,9 @@ int runCalibrate(const CalibrateOptions& opt) {
               {"target_file", fs::absolute(targetPath).string()},
               {"target", target}};
   const fs::path out = opt.outDir.empty() ? fs::path("runs/calibration") : fs::path(opt.outDir);
-  fs::create_directories(out);
+  // A new or empty folder, or this calibration's own (its calibration.json); locked for the whole
+  // calibration, the Python driver included (cli/study_folder.hpp).
+  claimStudyFolder(out, "calibrate --out", "calibration.json", "calibration", true);
   const fs::path inputsFile = out / "calibration.json";
   if (fs::exists(inputsFile)) {
     json previous;
