@@ -415,8 +415,11 @@ Execution parseExecution(const toml::table& root) {
   Execution e;
   e.jobs = static_cast<int>(t.integer("jobs", 1, 4096).value_or(0));
   e.threads = static_cast<int>(t.integer("threads", 1, 4096).value_or(0));
-  e.scheduler = t.string("scheduler").value_or("");
-  if (!e.scheduler.empty()) checkSchedulerAddress(e.scheduler, t.path("scheduler"));
+  // Given, it must be an address: an empty string is refused, not taken for "not given".
+  if (const auto scheduler = t.string("scheduler")) {
+    checkSchedulerAddress(*scheduler, t.path("scheduler"));
+    e.scheduler = *scheduler;
+  }
   return e;
 }
 

@@ -30,7 +30,8 @@ void checkSchedulerAddress(const std::string& address, const std::string& where)
   const bool portOk = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos &&
                       std::stol(port) <= 65535;
   if ((proto != "tcp" && proto != "tls") || colon <= scheme + 3 || !portOk) {
-    const std::string shown = address.size() > 80 ? address.substr(0, 77) + "..." : address;
+    const std::string shown =
+        address.empty() ? "\"\" (empty)" : address.size() > 80 ? address.substr(0, 77) + "..." : address;
     throw InputError(fmt::format("{} = {}: expected a Dask scheduler address tcp://HOST:PORT (or tls://HOST:PORT)",
                                  where, shown));
   }
