@@ -238,7 +238,7 @@ def wait_for_cases(sweep, out, count):
         time.sleep(0.05)
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT, signal.SIGKILL])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT, signal.SIGKILL], ids=["SIGTERM", "SIGINT", "SIGKILL"])
 def test_stopped_sweep_leaves_no_case_running(tiny, tmp_path, sig):
     out = tmp_path / "sweep"
     sweep = start_long_sweep(tiny, out)
