@@ -29,7 +29,7 @@ import nlopt
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import calibrate_report  # noqa: E402
 from calibrate_objective import InputProblem, Problem, Space, seed_statistics  # noqa: E402
-from dask_runner import DaskRunner, LocalRunner  # noqa: E402
+from dask_runner import DaskRunner, LocalRunner, Stopped, stop_on_signals  # noqa: E402
 
 ALGORITHMS = {"bobyqa": nlopt.LN_BOBYQA, "cobyla": nlopt.LN_COBYLA, "neldermead": nlopt.LN_NELDERMEAD,
               "sbplx": nlopt.LN_SBPLX, "direct": nlopt.GN_DIRECT_L, "crs2": nlopt.GN_CRS2_LM}
@@ -255,6 +255,8 @@ def main():
     parser.add_argument("--scheduler", default="")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args()
+    # SIGTERM and SIGHUP stop it as Ctrl-C does: the runs in progress are ended, what completed is kept.
+    stop_on_signals()
     folder = args.folder
     with open(os.path.join(folder, "calibration.json")) as f:
         inputs = json.load(f)
@@ -284,9 +286,16 @@ def main():
     except CalibrationError as e:
         print(f"grainlab: calibrate: {e}", file=sys.stderr)
         return 1
+    except ConnectionError as e:  # the scheduler went away mid-way (dask_runner.ClusterLost)
+        print(f"grainlab: calibrate: {e}; the runs that completed are kept: the same command resumes from {folder}",
+              file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"grainlab: calibrate: interrupted; the same command resumes from {folder}", file=sys.stderr)
         return 130
+    except Stopped as e:
+        print(f"grainlab: calibrate: interrupted ({e}); the same command resumes from {folder}", file=sys.stderr)
+        return 143
     finally:
         runner.close()
     if not args.quiet:

@@ -17,22 +17,42 @@ logged as a scheduler event, so the results say how many attempts a case took an
 docs/scale-out.md describes the set-up."""
 import io
 import json
+import logging
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
 import tarfile
 import tempfile
+import threading
 import time
 import uuid
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import CancelledError, ThreadPoolExecutor, as_completed
 
 EVENT_TOPIC = "grainlab-run-start"
 # Cases whose task raised (e.g. no grainlab executable on that worker) are tried again elsewhere;
 # a worker that dies is handled by the scheduler (distributed.scheduler.allowed-failures).
 TASK_RETRIES = 2
 WORKER_WAIT_S = 300
+
+
+class ClusterLost(ConnectionError):
+    """The scheduler went away mid-way: the cases reported until then stand, the others were not run."""
+
+
+class Stopped(BaseException):
+    """SIGTERM or SIGHUP reached the runner (raised in the main thread, like KeyboardInterrupt for SIGINT)."""
+
+
+def stop_on_signals():
+    """SIGTERM and SIGHUP raise Stopped in the main thread, so the runner ends its runs and reports."""
+    def handler(sig, frame):
+        raise Stopped(signal.Signals(sig).name)
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, handler)
+
 
 
 def case_argv(executable, config, out_dir, threads, sets):
@@ -96,9 +116,17 @@ def run_case(job):
         shutil.rmtree(run_dir)
     os.makedirs(os.path.dirname(os.path.abspath(run_dir)), exist_ok=True)
     started = time.time()
-    proc = subprocess.run(_child_argv(case_argv(executable, config, run_dir, threads, job["sets"])),
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-    result = {"name": job["name"], "exit_code": proc.returncode, "log": proc.stdout.decode(errors="replace"),
+    proc = subprocess.Popen(_child_argv(case_argv(executable, config, run_dir, threads, job["sets"])),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    registry = job.get("registry")  # LocalRunner's (local mode only: it does not travel)
+    if registry is not None:
+        registry.started(proc)
+    try:
+        output, _ = proc.communicate()
+    finally:
+        if registry is not None:
+            registry.finished(proc)
+    result = {"name": job["name"], "exit_code": proc.returncode, "log": output.decode(errors="replace"),
               "worker": worker.address if worker else "local", "host": socket.gethostname(),
               "started": started, "finished": time.time(), "files": None}
     try:
@@ -137,17 +165,41 @@ class LocalRunner:
 
     def __init__(self, jobs):
         self.jobs = jobs
+        self._procs = set()  # the runs in progress, ended when the runner is stopped
+        self._lock = threading.Lock()
+        self._stopping = False
+
+    def started(self, proc):
+        with self._lock:
+            self._procs.add(proc)
+            if self._stopping:  # started while the runner was being stopped
+                proc.kill()
+
+    def finished(self, proc):
+        with self._lock:
+            self._procs.discard(proc)
 
     def run(self, jobs, on_done):
-        """Runs every job; calls on_done(job, result) in this thread as each one completes."""
+        """Runs every job; calls on_done(job, result) in this thread as each one completes. Stopped
+        (a signal, KeyboardInterrupt, an exception of on_done), it ends the runs in progress first:
+        none is left writing into its folder after this returns."""
         with ThreadPoolExecutor(max_workers=self.jobs) as pool:
-            futures = {pool.submit(run_case, dict(job, mode="local")): job for job in jobs}
-            for future in as_completed(futures):
-                job = futures[future]
-                result = future.result()
-                result["attempts"] = 1
-                result["workers"] = ["local"]
-                on_done(job, result)
+            futures = {pool.submit(run_case, dict(job, mode="local", registry=self)): job for job in jobs}
+            try:
+                for future in as_completed(futures):
+                    job = futures[future]
+                    result = future.result()
+                    result["attempts"] = 1
+                    result["workers"] = ["local"]
+                    on_done(job, result)
+            except BaseException:
+                for future in futures:
+                    future.cancel()
+                with self._lock:
+                    self._stopping = True
+                    for proc in self._procs:
+                        proc.kill()
+                raise
 
     def close(self):
         pass
@@ -156,13 +208,14 @@ class LocalRunner:
 class DaskRunner:
     """Runs cases on the workers of a Dask distributed scheduler."""
 
-    def __init__(self, scheduler, shared_out=False, quiet=False):
+    def __init__(self, scheduler, shared_out=False, quiet=False, notices=None):
         import cloudpickle
         import dask
         from distributed import Client
         # The worker needs run_case but not this file: its module travels by value.
         cloudpickle.register_pickle_by_value(sys.modules[__name__])
         self.shared_out = shared_out
+        self.address = scheduler
         # Dask's own connect timeout (distributed.comm.timeouts.connect, 30 s unless configured, e.g.
         # DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=5s).
         timeout = dask.config.get("distributed.comm.timeouts.connect")
@@ -172,7 +225,7 @@ class DaskRunner:
             raise ConnectionError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
         if not self.client.scheduler_info()["workers"]:
             if not quiet:
-                print(f"waiting up to {WORKER_WAIT_S} s for a worker to join {scheduler}", file=sys.stderr)
+                print(f"waiting up to {WORKER_WAIT_S} s for a worker to join {scheduler}", file=notices or sys.stderr)
             try:
                 self.client.wait_for_workers(1, timeout=WORKER_WAIT_S)
             except TimeoutError:
@@ -189,12 +242,18 @@ class DaskRunner:
             futures[future] = (job, task["token"])
         for future in dask_completed(list(futures), loop=self.client.loop):
             job, token = futures[future]
-            starts = [msg for _, msg in self.client.get_events(EVENT_TOPIC) if msg.get("token") == token]
             try:
                 result = future.result()
+            except CancelledError:
+                # Cancelled by the client: the scheduler is gone, and with it every case not reported yet.
+                raise ClusterLost(f"the Dask scheduler {self.address} was lost") from None
             except Exception as e:  # the task itself raised on every try: no run took place
                 result = {"name": job["name"], "exit_code": 127, "log": f"{type(e).__name__}: {e}\n", "files": None,
                           "worker": "", "host": ""}
+            try:
+                starts = [msg for _, msg in self.client.get_events(EVENT_TOPIC) if msg.get("token") == token]
+            except (OSError, CancelledError) as e:
+                raise ClusterLost(f"the Dask scheduler {self.address} was lost ({type(e).__name__})") from None
             if result["files"] is not None:
                 _unpack(result["files"], job["out"])
             result["files"] = None
@@ -207,7 +266,21 @@ class DaskRunner:
                 shutil.rmtree(os.path.join(parent, ".attempts"), ignore_errors=True)
 
     def close(self):
-        self.client.close()
+        try:
+            self.client.close(timeout=10)
+        except Exception:  # a scheduler that is gone: nothing to close there
+            pass
+
+
+def _quiet_dask_logs(folder):
+    """Everything Dask and Python write to stderr (reconnection attempts, a lost scheduler's
+    tracebacks) goes to FOLDER/dask-client.log instead of the terminal, where the sweep says in one
+    line what happened. Returns the terminal's stderr, for the runner's own progress lines."""
+    terminal = os.fdopen(os.dup(2), "w", buffering=1)
+    log = open(os.path.join(folder, "dask-client.log"), "a", buffering=1)
+    os.dup2(log.fileno(), 2)
+    sys.stderr = log
+    return terminal
 
 
 def _sweep(manifest_path, results_path):
@@ -229,28 +302,45 @@ def _sweep(manifest_path, results_path):
             json.dump(results, f, indent=1)
         os.replace(tmp, results_path)
 
-    try:
-        runner = DaskRunner(manifest["scheduler"], shared_out=manifest["shared_out"], quiet=manifest["quiet"])
-    except ConnectionError as e:
-        write({"error": str(e), "exit_code": 1})
-        return 1
-
     def done(job, result):
         with open(os.path.join(manifest["out"], job["name"] + ".log"), "w") as f:
             f.write(result["log"])
         outcome[job["name"]] = {"exit_code": result["exit_code"], "attempts": result["attempts"],
                                 "workers": result["workers"]}
+        # Written as each case finishes: what finished is known however the runner ends.
+        write({"cases": outcome})
         if not manifest["quiet"]:
             status = "completed" if result["exit_code"] == 0 else f"failed (exit {result['exit_code']})"
             again = f" after {result['attempts']} attempts ({' then '.join(result['workers'])})" \
                 if result["attempts"] > 1 else ""
             print(f"[{len(outcome)}/{len(jobs)}] {job['name']}: {status} on {result['worker']}{again}",
-                  file=sys.stderr, flush=True)
+                  file=terminal, flush=True)
 
+    # Whatever ends the runner -- a scheduler that cannot be reached or goes away, a signal, an
+    # error -- it writes the cases that finished and one line saying why the others did not; the
+    # sweep makes its table from that (no traceback).
+    stop_on_signals()
+    terminal = _quiet_dask_logs(manifest["out"])
+    runner = None
     try:
+        runner = DaskRunner(manifest["scheduler"], shared_out=manifest["shared_out"], quiet=manifest["quiet"],
+                            notices=terminal)
         runner.run(jobs, done)
+    except ConnectionError as e:
+        write({"cases": outcome, "error": str(e)})
+        return 1
+    except KeyboardInterrupt:
+        write({"cases": outcome, "error": "interrupted (SIGINT)"})
+        return 130
+    except Stopped as e:
+        write({"cases": outcome, "error": f"interrupted ({e})"})
+        return 143
+    except Exception as e:
+        write({"cases": outcome, "error": f"the Dask runner failed: {type(e).__name__}: {e}"})
+        return 1
     finally:
-        runner.close()
+        if runner is not None:
+            runner.close()
     write({"cases": outcome})
     return 0
 

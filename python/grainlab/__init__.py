@@ -394,6 +394,9 @@ def sweep(config, vary, out=None, client=None, set=None, jobs=None, threads=None
         raise ConfigError(f"jobs = {jobs!r:.80}; allowed: None or an integer in [1, 4096]")
     if not isinstance(vary, dict) or not vary:
         raise ConfigError(f"sweep: vary = {vary!r:.80}; allowed: a non-empty dict {{key: [values]}}")
+    if out is not None and os.fspath(out) in ("", b""):
+        # The program would take an empty --out for "not given" (runs/sweep): refused.
+        raise ConfigError("sweep: out = '': empty; give a folder, or None for runs/sweep")
     with tempfile.TemporaryDirectory(prefix="grainlab-") as scratch:
         source, sets = cfg._program_args(scratch)
         argv = [executable(), "sweep", source, *sets]

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/study_folder.hpp"
 #include "cli/sweep_dask.hpp"
 #include "io/install_paths.hpp"
 #include "core/errors.hpp"
@@ -414,8 +415,11 @@ Execution parseExecution(const toml::table& root) {
   Execution e;
   e.jobs = static_cast<int>(t.integer("jobs", 1, 4096).value_or(0));
   e.threads = static_cast<int>(t.integer("threads", 1, 4096).value_or(0));
-  e.scheduler = t.string("scheduler").value_or("");
-  if (!e.scheduler.empty()) checkSchedulerAddress(e.scheduler, t.path("scheduler"));
+  // Given, it must be an address: an empty string is refused, not taken for "not given".
+  if (const auto scheduler = t.string("scheduler")) {
+    checkSchedulerAddress(*scheduler, t.path("scheduler"));
+    e.scheduler = *scheduler;
+  }
   return e;
 }
 
@@ -475,7 +479,9 @@ int runCalibrate(const CalibrateOptions& opt) {
               {"target_file", fs::absolute(targetPath).string()},
               {"target", target}};
   const fs::path out = opt.outDir.empty() ? fs::path("runs/calibration") : fs::path(opt.outDir);
-  fs::create_directories(out);
+  // A new or empty folder, or this calibration's own (its calibration.json); locked for the whole
+  // calibration, the Python driver included (cli/study_folder.hpp).
+  claimStudyFolder(out, "calibrate --out", "calibration.json", "calibration", true);
   const fs::path inputsFile = out / "calibration.json";
   if (fs::exists(inputsFile)) {
     json previous;

@@ -30,14 +30,15 @@ void checkSchedulerAddress(const std::string& address, const std::string& where)
   const bool portOk = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos &&
                       std::stol(port) <= 65535;
   if ((proto != "tcp" && proto != "tls") || colon <= scheme + 3 || !portOk) {
-    const std::string shown = address.size() > 80 ? address.substr(0, 77) + "..." : address;
+    const std::string shown =
+        address.empty() ? "\"\" (empty)" : address.size() > 80 ? address.substr(0, 77) + "..." : address;
     throw InputError(fmt::format("{} = {}: expected a Dask scheduler address tcp://HOST:PORT (or tls://HOST:PORT)",
                                  where, shown));
   }
 }
 
-std::vector<DaskCaseResult> runCasesOnDask(const SweepOptions& opt, const std::string& executable,
-                                           const fs::path& out, const std::vector<DaskCase>& cases, int threads) {
+DaskOutcome runCasesOnDask(const SweepOptions& opt, const std::string& executable, const fs::path& out,
+                           const std::vector<DaskCase>& cases, int threads) {
   checkSchedulerAddress(opt.scheduler, "--scheduler");
   // Workers may run in other folders or on other machines: the config by absolute path (its text
   // travels too, for workers that do not see that path), the results folder absolute.
@@ -59,7 +60,15 @@ std::vector<DaskCaseResult> runCasesOnDask(const SweepOptions& opt, const std::s
 
   const fs::path script = io::toolScript("dask_runner.py");
   if (script.empty()) throw std::runtime_error("sweep: tools/dask_runner.py is not installed beside the program");
-  const int rc = io::runProcess({GRAINLAB_PYTHON, script.string(), "sweep", manifestFile.string(), resultsFile.string()});
+  // The runner dies with the sweep; a stop signal is passed on to it, and it reports what finished.
+  const pid_t pid = io::startProcess({GRAINLAB_PYTHON, script.string(), "sweep", manifestFile.string(),
+                                      resultsFile.string()},
+                                     io::ChildOutput::inherit(), true);
+  io::StopForwarding::track(pid);
+  const int rc = io::waitProcess(pid);
+  io::StopForwarding::untrack(pid);
+  // The runner rewrites its results file as each case finishes, so what it finished is known
+  // however it ended.
   json results;
   std::ifstream in(resultsFile);
   if (in) {
@@ -69,18 +78,30 @@ std::vector<DaskCaseResult> runCasesOnDask(const SweepOptions& opt, const std::s
       results = nullptr;
     }
   }
-  if (results.contains("error")) throw std::runtime_error(fmt::format("sweep: {}", results["error"].get<std::string>()));
-  if (!results.contains("cases"))
-    throw std::runtime_error(fmt::format("sweep: the Dask runner {} stopped ({}) without results", script.string(),
-                                         rc > 128 ? fmt::format("signal {}", rc - 128) : fmt::format("exit {}", rc)));
-  std::vector<DaskCaseResult> outcome(cases.size());
+  DaskOutcome outcome;
+  outcome.cases.resize(cases.size());
+  const json none = json::object();
+  const json& done = results.is_object() && results.contains("cases") && results["cases"].is_object() ? results["cases"] : none;
+  std::size_t missing = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    const json& r = results["cases"].value(cases[i].name, json());
-    if (r.is_null()) throw std::runtime_error(fmt::format("sweep: no result for case {} from the Dask runner", cases[i].name));
-    outcome[i].exitCode = r["exit_code"].get<int>();
-    outcome[i].attempts = r["attempts"].get<int>();
-    for (const auto& w : r["workers"]) outcome[i].workers += (outcome[i].workers.empty() ? "" : " then ") + w.get<std::string>();
+    const json r = done.value(cases[i].name, json());
+    if (!r.is_object() || !r.contains("exit_code") || !r["exit_code"].is_number_integer()) {
+      ++missing;
+      continue;
+    }
+    DaskCaseResult& c = outcome.cases[i];
+    c.ran = true;
+    c.exitCode = r["exit_code"].get<int>();
+    c.attempts = r.value("attempts", 1);
+    if (r.contains("workers") && r["workers"].is_array())
+      for (const auto& w : r["workers"])
+        if (w.is_string()) c.workers += (c.workers.empty() ? "" : " then ") + w.get<std::string>();
   }
+  if (results.is_object() && results.contains("error") && results["error"].is_string())
+    outcome.error = results["error"].get<std::string>();
+  else if (missing > 0)
+    outcome.error = fmt::format("the Dask runner {} stopped ({}) before every case was reported", script.string(),
+                                rc > 128 ? fmt::format("signal {}", rc - 128) : fmt::format("exit {}", rc));
   return outcome;
 }
 
