@@ -116,6 +116,7 @@ lab::RunConfig resolveConfig(const RunOptions& opt) {
 }  // namespace
 
 std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
+  for (const auto& w : config.warnings) std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
   if (config.sample.grading.type == "list") {
     const std::vector<double> list = lab::readDiameterList(config.sample.grading.file);
     const auto [dMin, dMax] = std::minmax_element(list.begin(), list.end());
@@ -499,6 +500,7 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
     summary["test"] = config.test.type;
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
+    for (const auto& w : config.warnings) summary["warnings"].push_back(w);
     RunSession session(config, folder, opt.quiet, summary, 0.0, {}, {}, observer);
     lab::Laboratory& lab = session.lab();
     try {

@@ -472,9 +472,6 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
       "sample.growth_rate",  "sample.lattice_jitter", "sample.shape"};
   if (packing && (preparation.count(key) || key.rfind("sample.shape.", 0) == 0))
     return "not used with sample.packing (a packing file is taken as it is: no preparation)";
-  if (packing && key == "sample.grading" && c.sample.grading.type != "packing")
-    return "not used with sample.packing (the packing brings its own grains); allowed: no sample.grading, or "
-           "{ type = \"packing\" }";
   if (!packing && key == "sample.grading" && c.sample.grading.type == "packing")
     return "{ type = \"packing\" } needs sample.packing";
   if (key == "sample.growth_rate" && method != "growth")
@@ -506,8 +503,7 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "only used with test.type = \"simple-shear\"; " + here("test.type", type);
   if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
     return "only used with test.unload_reload_at (unload-reload loops)";
-  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed" || key == "output.band_factor" ||
-       key == "output.record_every_strain" || key == "output.checkpoint_every") && !shear)
+  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed") && !shear)
     return "not used with test.type = \"isotropic\" (no shearing)";
   if (key == "solver.force_dt" && !c.solver.dt) return "only used with solver.dt (it allows a dt above the critical step)";
   if (key == "solver.damping" && c.solver.viscousDamping > 0.0)
@@ -518,17 +514,33 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   return "";
 }
 
-// Refuses every key given that cannot apply, naming it and the key that rules it out.
-void refuseInapplicable(const toml::table& root, const lab::RunConfig& c) {
+// Refuses every key given that cannot apply, naming it and the key that rules it out. The
+// preparation keys beside sample.packing are the exception: a config that prepared a sample is meant
+// to be reused with --set sample.packing=... (its packing.txt); they are ignored with a warning
+// (lab::RunConfig::warnings, printed by `check` and `run` and kept in the summary).
+void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
   for (const auto& [table, keys] : knownKeys())
     for (const auto& k : keys) {
       const std::string key = table + "." + k;
       const toml::node* node = root.at_path(key).node();
       if (!node) continue;
-      const std::string why = inapplicable(c, key);
+      std::string why = inapplicable(c, key);
+      if (key == "sample.grading" && !c.sample.packing.empty()) {
+        const toml::node* type = node->is_table() ? node->as_table()->get("type") : nullptr;
+        if (!type || type->value<std::string>() != std::optional<std::string>("packing"))
+          why = "not used with sample.packing (the packing brings its own grains)";
+      }
       // solver.damping = 0 beside a viscous damping states "no local damping": consistent, kept.
       if (key == "solver.damping" && node->is_number() && numberOf(*node) == 0.0) continue;
-      if (!why.empty()) fail(key, show(*node), "cannot apply: " + why + fmt::format(" (remove {})", key));
+      if (why.empty()) continue;
+      // Ignoring is intended for the targets of a preparation that does not use them (a config
+      // reused with a packing, or with another sample.method): a warning, not an error.
+      const bool preparationTarget = key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg";
+      if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget) {
+        c.warnings.push_back(fmt::format("{} = {} is ignored: {}", key, printable(show(*node)), why));
+        continue;
+      }
+      fail(key, show(*node), "cannot apply: " + why + fmt::format(" (remove {})", key));
     }
 }
 

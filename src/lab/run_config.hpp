@@ -156,6 +156,9 @@ struct OutputConfig {
 };
 
 struct RunConfig {
+  // Keys given that were ignored (preparation keys beside sample.packing), one message each; not
+  // part of the resolved config.
+  std::vector<std::string> warnings;
   SampleConfig sample;
   ContactConfig contact;
   TestConfig test;

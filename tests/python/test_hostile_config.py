@@ -82,7 +82,11 @@ def test_resolved_config_records_the_packing(base, tmp_path, grainlab):
     grainlab("check", str(out / "config.resolved.toml"), "--set", f"output.dir={tmp_path / 'third'}", check=0)
     # A count that contradicts the packing is refused.
     refused(run("check", str(cfg), "--set", "sample.n_particles=99"), "sample.n_particles = 99", "holds 100")
-    refused(run("check", str(cfg), "--set", "sample.e0=0.7"), "sample.e0", "sample.packing")
+    # Preparation keys beside a packing (a config reused with --set sample.packing=...) are ignored
+    # with a warning, and not recorded.
+    proc = grainlab("check", str(cfg), "--set", "sample.e0=0.7", "--set", f"output.dir={out}", check=0)
+    assert "warning: sample.e0 = 0." in proc.stderr and "sample.packing" in proc.stderr
+    assert "e0" not in tomllib.loads(proc.stdout)["sample"]
 
 
 # 4. --set paths are relative to the working directory, config paths to the config's folder.
@@ -111,8 +115,6 @@ def test_set_paths_relative_to_working_directory(base, tmp_path, grainlab):
     (['sample.shape={ type = "sphere", elongation = 0.7 }'], ["sample.shape.elongation", "sample.shape.type"]),
     (["test.boundary=periodic", "contact.wall_friction_deg=10", "sample.n_particles=400"],
      ["contact.wall_friction_deg", "test.boundary"]),
-    (["sample.method=lattice", "sample.n_particles=125", "sample.prep_friction_deg=auto", "sample.e0=0.6",
-      'sample.grading={ type = "uniform", d_min = 5e-3, d_max = 5e-3 }'], ["sample.e0", "sample.method"]),
     (["sample.method=lattice", "sample.n_particles=125"], ["sample.grading", "lattice"]),
     (["contact.model=rolling-linear", "contact.beta=0.2"], ["contact.beta", "contact.model"]),
     (["contact.model=rolling-linear", "contact.eta=0.5"], ["contact.eta", "contact.model"]),
@@ -129,6 +131,13 @@ def test_settings_that_cannot_apply(base, sets, words):
         sets = sets + ["contact.young=30e9"]
     line = refused(run("check", str(base), *[a for s in sets for a in ("--set", s)]), *words)
     assert "cannot apply" in line or "lattice" in line
+
+
+def test_preparation_target_ignored_by_the_method_warns(base, grainlab):
+    proc = grainlab("check", str(base), "--set", "sample.method=lattice", "--set", "sample.n_particles=125", "--set",
+                    'sample.grading={ type = "uniform", d_min = 5e-3, d_max = 5e-3 }', check=0)
+    assert "warning: sample.e0 = " in proc.stderr and "sample.method" in proc.stderr
+    assert "e0" not in tomllib.loads(proc.stdout)["sample"]
 
 
 def test_every_shipped_config_passes_check_and_round_trips(grainlab, tmp_path):
