@@ -66,14 +66,14 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
     };
     if (psiCol >= 0) {
       const double psi = number(psiCol, "sphericity");
-      if (!(psi > 0.0) || psi < DBL_MIN) throw fail(lineNo, fmt::format("sphericity {} must be a normal number > 0 (>= 2.2e-308)", psi));
+      if (!(psi > 0.0) || psi < DBL_MIN) throw fail(lineNo, fmt::format("sphericity {} must be > 0 (a normal number, >= 2.2e-308)", psi));
       d.values.push_back(psi);
       d.lines.push_back(lineNo);
     } else {
       const double lo = number(lowCol, "bin_low"), hi = number(highCol, "bin_high"), fr = number(freqCol, "frequency");
       if (!(lo >= DBL_MIN) || !(hi > lo))
         throw fail(lineNo, fmt::format("bin [{}, {}) must satisfy 0 < bin_low < bin_high (bin_low a normal number >= 2.2e-308)", lo, hi));
-      if (fr < 0.0 || (fr > 0.0 && fr < DBL_MIN)) throw fail(lineNo, fmt::format("frequency {} must be 0 or a normal number > 0", fr));
+      if (fr < 0.0 || (fr > 0.0 && fr < DBL_MIN)) throw fail(lineNo, fmt::format("frequency {} must be >= 0 (0 or a normal number)", fr));
       d.lines.push_back(lineNo);
       d.binLow.push_back(lo);
       d.binHigh.push_back(hi);
