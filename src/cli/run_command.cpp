@@ -33,6 +33,7 @@
 #include "lab/macro.hpp"
 #include "lab/micro_network.hpp"
 #include "lab/protocols.hpp"
+#include "lab/preflight.hpp"
 #include "lab/sphericity.hpp"
 
 namespace grainlab::cli {
@@ -118,10 +119,32 @@ lab::RunConfig resolveConfig(const RunOptions& opt) {
 }  // namespace
 
 std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
-  if (config.sample.grading.type == "list") lab::readDiameterList(config.sample.grading.file);
-  if (config.contact.sphericity) lab::readSphericityFile(config.contact.sphericity->file, "contact.sphericity.file");
-  if (config.sample.packing.empty()) return std::nullopt;
+  for (const auto& w : config.warnings) std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
+  if (config.sample.grading.type == "list") {
+    const std::vector<double> list = lab::readDiameterList(config.sample.grading.file);
+    const auto [dMin, dMax] = std::minmax_element(list.begin(), list.end());
+    if (config.sample.method == "lattice" && *dMax > 1.01 * *dMin)
+      throw InputError(fmt::format("config error: sample.grading.file = {}: diameters from {:g} to {:g} m, but "
+                                   "sample.method = \"lattice\" places equal spheres (the grading's d50); allowed: a "
+                                   "grading of one size (d_max <= 1.01 d_min)",
+                                   io::quotedPath(config.sample.grading.file), *dMin, *dMax));
+  }
+  if (config.contact.sphericity) {
+    const lab::SphericityConfig& sc = *config.contact.sphericity;
+    lab::checkRollingFriction(lab::readSphericityFile(sc.file, "contact.sphericity.file"), sc.c, sc.k, sc.file,
+                              "contact.sphericity.file");
+  }
+  if (config.sample.packing.empty()) {
+    lab::preflight(config, nullptr);
+    return std::nullopt;
+  }
   const io::PackingData packing = io::readPackingFile(config.sample.packing, "sample.packing");
+  io::checkPackingGeometry(packing, fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
+  if (config.sample.nParticlesGiven && static_cast<std::size_t>(config.sample.nParticles) != packing.particles.size())
+    throw InputError(fmt::format("config error: sample.n_particles = {}: sample.packing = {} holds {} particles; allowed: "
+                                 "no sample.n_particles, or {}",
+                                 config.sample.nParticles, io::quotedPath(config.sample.packing),
+                                 packing.particles.size(), packing.particles.size()));
   Simulation packed;
   io::simulationFromPacking(packing, config.sample.density, packed,
                             fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
@@ -132,14 +155,25 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
                                  "test.boundary = \"{}\"; allowed: the packing's own boundary",
                                  io::quotedPath(config.sample.packing), periodic ? "a periodic cell" : "walls",
                                  config.test.boundary));
+  lab::preflight(config, &packed);
   return packed;
+}
+
+lab::RunConfig ranConfig(const lab::RunConfig& config, const std::optional<Simulation>& packed) {
+  lab::RunConfig ran = config;
+  if (packed) {
+    ran.sample.nParticles = static_cast<int>(packed->particles.size());
+    ran.sample.nParticlesGiven = true;
+    ran.sample.grading = lab::GradingConfig{.type = "packing", .diameters = {}, .passing = {}};
+  }
+  return ran;
 }
 
 int checkConfig(const RunOptions& opt) {
   const lab::RunConfig config = resolveConfig(opt);
-  loadInputFiles(config);
+  const std::optional<Simulation> packed = loadInputFiles(config);
   io::RunFolder::checkReplaceable(config.output.dir);
-  std::fputs(io::toTomlString(io::resolvedTable(config)).c_str(), stdout);
+  std::fputs(io::toTomlString(io::resolvedTable(ranConfig(config, packed))).c_str(), stdout);
   return 0;
 }
 
@@ -517,9 +551,10 @@ void checkCheckpointBelongsToFolder(const json& checkpointSummary, const fs::pat
 
 int runLab(const RunOptions& opt) { return runResolved(resolveConfig(opt), opt, {}); }
 
-int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::ProgressFn& observer) {
+int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const lab::ProgressFn& observer) {
   // Every input file is read and checked before the results folder is touched.
-  std::optional<Simulation> packed = loadInputFiles(config);
+  std::optional<Simulation> packed = loadInputFiles(requested);
+  const lab::RunConfig config = ranConfig(requested, packed);  // with a packing: its n_particles and grading
   useThreads(config.solver.threads);
   io::RunFolder folder = io::RunFolder::forRun(config.output.dir);
   return inFolder(folder, [&] {
@@ -536,6 +571,7 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
     summary["test"] = config.test.type;
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
+    for (const auto& w : config.warnings) summary["warnings"].push_back(w);
     RunSession session(config, folder, opt.quiet, summary, 0.0, {}, {}, observer);
     lab::Laboratory& lab = session.lab();
     try {
@@ -555,6 +591,18 @@ int runResolved(const lab::RunConfig& config, const RunOptions& opt, const lab::
       // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
       s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
       s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
+      if (!s["e0_within_tolerance"].get<bool>() && !packed.has_value() &&
+          (config.sample.method == "compaction" || config.sample.method == "loose-moment-free")) {
+        // A missed e0 target (a given prep_friction_deg is not searched) is reported, never silent.
+        const std::string w = fmt::format(
+            "e0 = {:.4f} misses sample.e0 = {} by more than sample.e0_tolerance = {}{}", prep.e0, config.sample.e0,
+            config.sample.e0Tolerance,
+            config.sample.prepFrictionDeg
+                ? fmt::format(" (sample.prep_friction_deg = {} is fixed, not searched)", *config.sample.prepFrictionDeg)
+                : std::string());
+        std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
+        s["warnings"].push_back(w);
+      }
       // A packing file is taken as it is: no preparation friction was used.
       s["prep_friction_deg"] = prep.prepFrictionDeg ? json(*prep.prepFrictionDeg) : json(nullptr);
       s["preparation_method"] = config.sample.packing.empty() ? config.sample.method : "packing file";

@@ -129,10 +129,11 @@ void checkNesting(std::string_view text, const std::string& subject) {
   }
 }
 
-// A relative path in a config names a file beside that config (for a preset: in the installed
-// share/grainlab/presets, io/install_paths.hpp), or,
-// failing that, one relative to the working directory. Resolved paths are absolute, so the
-// resolved config stays valid wherever it is read.
+// One rule for relative paths (docs/interface.md): a relative path in a config file names a file
+// relative to that config's folder (for a preset: the installed share/grainlab/presets,
+// io/install_paths.hpp); a path given with --set (applyOverride) is relative to the working
+// directory, made absolute there. Resolved paths are absolute, so the resolved config stays valid
+// wherever it is read.
 bool pathExists(const std::filesystem::path& path) {
   std::error_code ec;  // a name too long or a folder not searchable: not there
   return std::filesystem::exists(path, ec);
@@ -141,13 +142,120 @@ bool pathExists(const std::filesystem::path& path) {
 std::string resolvePath(const std::string& path, const std::string& baseDir) {
   namespace fs = std::filesystem;
   if (path.empty() || fs::path(path).is_absolute()) return path;
-  if (!baseDir.empty() && pathExists(fs::path(baseDir) / path)) return fs::absolute(fs::path(baseDir) / path).string();
-  return pathExists(path) ? fs::absolute(path).string() : path;
+  return fs::absolute(baseDir.empty() ? fs::path(path) : fs::path(baseDir) / path).lexically_normal().string();
+}
+
+std::string notFound(const std::string& resolved) {
+  return fmt::format("file not found: {} (a relative path in a config file is relative to the config's folder; "
+                     "one given with --set, to the working directory)", quotedPath(resolved));
 }
 
 // `value` comes already cut (show, quotedPath); the key may be a user's unknown key.
 [[noreturn]] void fail(const std::string& key, const std::string& value, const std::string& allowed) {
   throw InputError(fmt::format("config error: {} = {}: {}", printable(key), printable(value, 300), allowed));
+}
+
+// Subnormal numbers (0 < |v| < 2.2e-308) have lost their precision and pass every "> 0" check:
+// refused wherever a config gives a number.
+bool subnormal(double v) { return std::fpclassify(v) == FP_SUBNORMAL; }
+constexpr const char* kSubnormal = "is subnormal (0 < |value| < 2.2e-308, below the smallest normal double)";
+
+// Every key of every section and of the inline tables. The unknown-key check runs on all of them
+// before any value or cross-key check, so that a misspelt key is reported as such.
+const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> keys{
+      {"sample",
+       {"n_particles", "grading", "density", "e0", "seed", "prep_friction_deg", "e0_tolerance", "initial_void_ratio",
+        "packing", "prep_stiffness_factor", "prep_ramp_steps", "prep_damping", "method", "growth_rate",
+        "lattice_jitter", "shape"}},
+      {"contact",
+       {"model", "young", "poisson", "friction_deg", "beta", "eta", "wall_friction_deg", "moment_limit", "kn",
+        "rolling_friction", "sphericity"}},
+      {"test",
+       {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
+        "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
+        "loop_rest", "unload_to_q_fraction"}},
+      {"solver",
+       {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
+        "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
+      {"output",
+       {"dir", "record_every_strain", "plots", "save_packing", "checkpoint_every", "vtk_every_strain",
+        "micro_snapshots", "band_factor"}},
+      {"sample.grading", {"type", "diameters", "passing", "d_min", "d_max", "file"}},
+      {"sample.shape", {"type", "elongation", "flatness", "orientation", "fraction", "eccentricity_step"}},
+      {"contact.sphericity", {"file", "c", "k", "combine"}},
+  };
+  return keys;
+}
+
+const std::vector<std::string>* keysOf(const std::string& table) {
+  for (const auto& [name, keys] : knownKeys())
+    if (name == table) return &keys;
+  return nullptr;
+}
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// "; did you mean ...?" for a near miss (up to 2 edits, or a quarter of the key), or a key of
+// another section with this name; empty otherwise.
+std::string didYouMean(const std::string& table, const std::string& key) {
+  std::string best;
+  std::size_t bestDistance = std::max<std::size_t>(2, key.size() / 4) + 1;
+  for (const auto& k : *keysOf(table)) {
+    const std::size_t d = editDistance(key, k);
+    if (d < bestDistance) bestDistance = d, best = table + "." + k;
+  }
+  if (best.empty())
+    for (const auto& [name, keys] : knownKeys())
+      if (name != table && name.find('.') == std::string::npos && std::find(keys.begin(), keys.end(), key) != keys.end())
+        best = name + "." + key;
+  return best.empty() ? std::string() : fmt::format("; did you mean {}?", best);
+}
+
+[[noreturn]] void failUnknown(const std::string& table, const std::string& key, const toml::node& value) {
+  std::string known;
+  for (const auto& k : *keysOf(table)) known += (known.empty() ? "" : ", ") + k;
+  fail(table + "." + key, show(value),
+       fmt::format("unknown key{}; known keys in {}: {}", didYouMean(table, key),
+                   table.find('.') == std::string::npos ? "[" + table + "]" : table, known));
+}
+
+// The unknown-key check of the whole config, first of all checks.
+void checkUnknownKeys(const toml::table& root) {
+  static const std::vector<std::string> sections{"sample", "contact", "test", "solver", "output"};
+  for (const auto& [k, v] : root) {
+    const std::string section(k.str());
+    if (std::find(sections.begin(), sections.end(), section) == sections.end()) {
+      std::string near;
+      for (const auto& s : sections)
+        if (editDistance(section, s) <= 2) near = fmt::format("; did you mean [{}]?", s);
+      fail(section, show(v), "unknown section" + near + "; allowed: [sample], [contact], [test], [solver], [output]");
+    }
+    if (!v.is_table()) fail(section, show(v), "must be a table");
+    for (const auto& [key, value] : *v.as_table()) {
+      const std::string name(key.str());
+      const std::vector<std::string>& keys = *keysOf(section);
+      if (std::find(keys.begin(), keys.end(), name) == keys.end()) failUnknown(section, name, value);
+      const std::string inner = section + "." + name;
+      if (const std::vector<std::string>* sub = keysOf(inner); sub && value.is_table())
+        for (const auto& [k2, v2] : *value.as_table())
+          if (std::find(sub->begin(), sub->end(), std::string(k2.str())) == sub->end())
+            failUnknown(inner, std::string(k2.str()), v2);
+    }
+  }
 }
 
 // One [section] of the config: typed getters with defaults and ranges, and a check that every key
@@ -161,6 +269,9 @@ class Section {
   }
 
   const toml::node* raw(const std::string& key) {
+    const std::vector<std::string>& keys = *keysOf(name_);
+    if (std::find(keys.begin(), keys.end(), key) == keys.end())
+      throw std::logic_error("config.cpp: key " + path(key) + " is missing from knownKeys()");
     used_.insert(key);
     return table_ ? table_->get(key) : nullptr;
   }
@@ -173,6 +284,7 @@ class Section {
     if (!n->is_number()) fail(path(key), show(*n), "must be a number; " + allowed);
     const double v = numberOf(*n);
     if (!std::isfinite(v)) fail(path(key), show(*n), "must be a finite number; " + allowed);
+    if (subnormal(v)) fail(path(key), show(*n), std::string(kSubnormal) + "; " + allowed);
     if ((loOpen ? v <= lo : v < lo) || (hiOpen ? v >= hi : v > hi)) fail(path(key), show(*n), allowed);
     return v;
   }
@@ -208,6 +320,7 @@ class Section {
     std::vector<double> out;
     for (const auto& e : *node.as_array()) {
       if (!e.is_number() || !std::isfinite(numberOf(e))) fail(key, show(node), "must be an array of finite numbers");
+      if (subnormal(numberOf(e))) fail(key, show(node), std::string("an element ") + kSubnormal);
       out.push_back(numberOf(e));
     }
     return out;
@@ -219,9 +332,7 @@ class Section {
       const std::string key(k.str());
       if (used_.count(key) || std::find(extraKnown.begin(), extraKnown.end(), key) != extraKnown.end())
         continue;
-      std::string known;
-      for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
-      fail(path(key), show(v), "unknown key; known keys in [" + name_ + "]: " + known);
+      failUnknown(name_, key, v);
     }
   }
 
@@ -241,8 +352,12 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
   std::set<std::string> known;
   auto get = [&](const char* k) { known.insert(k); return t.get(k); };
   const toml::node* type = get("type");
-  if (!type || !type->is_string()) fail(key + ".type", type ? show(*type) : "(missing)", "allowed: \"curve\", \"uniform\", \"list\"");
+  if (!type || !type->is_string())
+    fail(key + ".type", type ? show(*type) : "(missing)", "allowed: \"curve\", \"uniform\", \"list\" (\"packing\" with sample.packing)");
   g.type = type->value<std::string>().value();
+  // Diameters within [kMinDiameter, kMaxDiameter]: a grain of 1e-300 m or 1e300 m is no test.
+  const std::string range = fmt::format("[{:g}, {:g}] m", lab::kMinDiameter, lab::kMaxDiameter);
+  auto inRange = [](double d) { return d >= lab::kMinDiameter && d <= lab::kMaxDiameter; };
   if (g.type == "curve") {
     const toml::node* d = get("diameters");
     const toml::node* p = get("passing");
@@ -253,7 +368,7 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
     if (g.diameters.size() < 2 || g.diameters.size() != g.passing.size())
       fail(key + ".passing", show(*p), "must have one value per diameter (at least 2)");
     for (std::size_t i = 0; i < g.diameters.size(); ++i) {
-      if (!(g.diameters[i] > 0.0)) fail(key + ".diameters", show(*d), "diameters must be > 0 [m]");
+      if (!inRange(g.diameters[i])) fail(key + ".diameters", show(*d), "every diameter must be in " + range);
       if (i > 0 && !(g.diameters[i] > g.diameters[i - 1])) fail(key + ".diameters", show(*d), "diameters must increase strictly");
       if (i > 0 && g.passing[i] < g.passing[i - 1]) fail(key + ".passing", show(*p), "percent passing must not decrease");
     }
@@ -262,19 +377,23 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
   } else if (g.type == "uniform") {
     const toml::node* lo = get("d_min");
     const toml::node* hi = get("d_max");
-    if (!lo || !lo->is_number()) fail(key + ".d_min", lo ? show(*lo) : "(missing)", "a diameter > 0 [m] is required");
-    if (!hi || !hi->is_number()) fail(key + ".d_max", hi ? show(*hi) : "(missing)", "a diameter >= d_min [m] is required");
+    if (!lo || !lo->is_number()) fail(key + ".d_min", lo ? show(*lo) : "(missing)", "a diameter in " + range + " is required");
+    if (!hi || !hi->is_number()) fail(key + ".d_max", hi ? show(*hi) : "(missing)", "a diameter >= d_min in " + range + " is required");
     g.dMin = numberOf(*lo);
     g.dMax = numberOf(*hi);
-    if (!(g.dMin > 0.0) || !std::isfinite(g.dMin)) fail(key + ".d_min", show(*lo), "must be a finite diameter > 0 [m]");
-    if (!(g.dMax >= g.dMin) || !std::isfinite(g.dMax)) fail(key + ".d_max", show(*hi), "must be a finite diameter >= d_min [m]");
+    if (!inRange(g.dMin)) fail(key + ".d_min", show(*lo), "must be a diameter in " + range);
+    if (!(g.dMax >= g.dMin) || !inRange(g.dMax))
+      fail(key + ".d_max", show(*hi), fmt::format("must be a diameter in [d_min = {:g}, {:g}] m", g.dMin, lab::kMaxDiameter));
   } else if (g.type == "list") {
     const toml::node* f = get("file");
     if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
     g.file = resolvePath(f->value<std::string>().value(), baseDir);
-    if (!pathExists(g.file)) fail(key + ".file", show(*f), "file not found");
+    if (!pathExists(g.file)) fail(key + ".file", show(*f), notFound(g.file));
+  } else if (g.type == "packing") {
+    // The grading of a packing file is its own (recorded so in config.resolved.toml).
+    if (!s.raw("packing")) fail(key + ".type", show(*type), "\"packing\" is the grading of sample.packing; give sample.packing");
   } else {
-    fail(key + ".type", show(*type), "allowed: \"curve\", \"uniform\", \"list\"");
+    fail(key + ".type", show(*type), "allowed: \"curve\", \"uniform\", \"list\" (\"packing\" with sample.packing)");
   }
   for (const auto& [k, v] : t)
     if (!known.count(std::string(k.str())))
@@ -312,7 +431,7 @@ lab::ShapeConfig parseShape(Section& s) {
     const toml::node* n = t.get(k);
     if (!n) return def;
     const std::optional<double> v = n->value<double>();
-    if (!n->is_number() || !v || !std::isfinite(*v) || *v <= lo || *v > hi) fail(key + "." + k, show(*n), allowed);
+    if (!n->is_number() || !v || !std::isfinite(*v) || subnormal(*v) || *v <= lo || *v > hi) fail(key + "." + k, show(*n), allowed);
     return *v;
   };
   auto text = [&](const char* k, const std::string& def, const std::vector<std::string>& allowed) {
@@ -335,6 +454,94 @@ lab::ShapeConfig parseShape(Section& s) {
   if (shape.type == "ellipsoid" && shape.elongation == 1.0 && shape.flatness == 1.0)
     fail(key + ".elongation", "1", "an ellipsoid needs elongation < 1 or flatness < 1 (else type = \"sphere\")");
   return shape;
+}
+
+// Why a key cannot apply under the rest of the config `c`, or "" where it applies. A key given
+// (whatever its value, its default included) that cannot apply is refused; config.resolved.toml
+// and `check` write exactly the keys that apply, so that a resolved config is itself a valid config.
+std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
+  const bool packing = !c.sample.packing.empty();
+  const std::string& method = c.sample.method;
+  const std::string& type = c.test.type;
+  const bool searched = method == "compaction" || method == "loose-moment-free";
+  const bool shear = type != "isotropic";
+  auto here = [](const char* k, const std::string& v) { return fmt::format("here {} = \"{}\"", k, v); };
+  static const std::set<std::string> preparation{
+      "sample.e0",           "sample.e0_tolerance", "sample.prep_friction_deg", "sample.initial_void_ratio",
+      "sample.prep_stiffness_factor", "sample.prep_ramp_steps", "sample.prep_damping", "sample.method",
+      "sample.growth_rate",  "sample.lattice_jitter", "sample.shape"};
+  if (packing && (preparation.count(key) || key.rfind("sample.shape.", 0) == 0))
+    return "not used with sample.packing (a packing file is taken as it is: no preparation)";
+  if (!packing && key == "sample.grading" && c.sample.grading.type == "packing")
+    return "{ type = \"packing\" } needs sample.packing";
+  if (key == "sample.growth_rate" && method != "growth")
+    return "only used with sample.method = \"growth\"; " + here("sample.method", method);
+  if ((key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg") && !searched)
+    return "only used with sample.method = \"compaction\" or \"loose-moment-free\" (a frictionless " + method +
+           " reaches its own e0); " + here("sample.method", method);
+  if (key == "sample.initial_void_ratio" && method == "lattice")
+    return "not used with sample.method = \"lattice\" (no loose placement)";
+  if (key.rfind("sample.shape.", 0) == 0 && key != "sample.shape.type" && c.sample.shape.type != "ellipsoid")
+    return "only used with sample.shape.type = \"ellipsoid\"; " + here("sample.shape.type", c.sample.shape.type);
+  const bool linear = c.contact.model == "rolling-linear";
+  if ((key == "contact.beta" || key == "contact.eta" || key == "contact.moment_limit") && linear)
+    return "only used with contact.model = \"kozicki\" (rolling-linear has rolling_friction or sphericity); " +
+           here("contact.model", c.contact.model);
+  if ((key == "contact.rolling_friction" || key == "contact.sphericity") && !linear)
+    return "only used with contact.model = \"rolling-linear\"; " + here("contact.model", c.contact.model);
+  if (key == "contact.rolling_friction" && c.contact.sphericity)
+    return "give either contact.rolling_friction or contact.sphericity, not both";
+  if (key == "contact.wall_friction_deg" && c.test.boundary == "periodic")
+    return "a periodic cell has no walls; " + here("test.boundary", c.test.boundary);
+  if (key == "contact.young" && c.contact.kn)
+    return "not used with contact.kn (every contact has the constant normal stiffness kn)";
+  if (key == "test.b" && type != "true-triaxial")
+    return "only used with test.type = \"true-triaxial\"; " + here("test.type", type);
+  if ((key == "test.axial_strain_rate" || key == "test.final_axial_strain") && (!shear || type == "simple-shear"))
+    return "only used with test.type = \"triaxial\", \"constant-p\" or \"true-triaxial\"; " + here("test.type", type);
+  if ((key == "test.shear_strain_rate" || key == "test.final_shear_strain") && type != "simple-shear")
+    return "only used with test.type = \"simple-shear\"; " + here("test.type", type);
+  if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
+    return "only used with test.unload_reload_at (unload-reload loops)";
+  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed") && !shear)
+    return "not used with test.type = \"isotropic\" (no shearing)";
+  if (key == "solver.force_dt" && !c.solver.dt) return "only used with solver.dt (it allows a dt above the critical step)";
+  if (key == "solver.damping" && c.solver.viscousDamping > 0.0)
+    return fmt::format("not used with solver.viscous_damping = {} > 0 (viscous damping replaces the local damping)",
+                       c.solver.viscousDamping);
+  if (key == "output.micro_snapshots" && c.output.microSnapshots && c.output.vtkEveryStrain == 0.0)
+    return "the contact-network snapshots are taken with the VTK ones, and output.vtk_every_strain = 0";
+  return "";
+}
+
+// Refuses every key given that cannot apply, naming it and the key that rules it out. The
+// preparation keys beside sample.packing are the exception: a config that prepared a sample is meant
+// to be reused with --set sample.packing=... (its packing.txt); they are ignored with a warning
+// (lab::RunConfig::warnings, printed by `check` and `run` and kept in the summary).
+void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
+  for (const auto& [table, keys] : knownKeys())
+    for (const auto& k : keys) {
+      const std::string key = table + "." + k;
+      const toml::node* node = root.at_path(key).node();
+      if (!node) continue;
+      std::string why = inapplicable(c, key);
+      if (key == "sample.grading" && !c.sample.packing.empty()) {
+        const toml::node* type = node->is_table() ? node->as_table()->get("type") : nullptr;
+        if (!type || type->value<std::string>() != std::optional<std::string>("packing"))
+          why = "not used with sample.packing (the packing brings its own grains)";
+      }
+      // solver.damping = 0 beside a viscous damping states "no local damping": consistent, kept.
+      if (key == "solver.damping" && node->is_number() && numberOf(*node) == 0.0) continue;
+      if (why.empty()) continue;
+      // Ignoring is intended for the targets of a preparation that does not use them (a config
+      // reused with a packing, or with another sample.method): a warning, not an error.
+      const bool preparationTarget = key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg";
+      if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget) {
+        c.warnings.push_back(fmt::format("{} = {} is ignored: {}", key, printable(show(*node)), why));
+        continue;
+      }
+      fail(key, show(*node), "cannot apply: " + why + fmt::format(" (remove {})", key));
+    }
 }
 
 }  // namespace
@@ -370,6 +577,24 @@ toml::table loadConfigTable(const std::string& source) {
   }
 }
 
+namespace {
+// The keys that name input files.
+bool isPathKey(const std::string& key) {
+  return key == "sample.packing" || key == "sample.grading.file" || key == "contact.sphericity.file";
+}
+// A relative path given with --set is relative to the working directory: made absolute here, before
+// the config's folder is applied to the config's own relative paths.
+void absolutizePaths(toml::node& node, const std::string& key) {
+  if (auto* t = node.as_table()) {
+    for (auto&& [k, v] : *t) absolutizePaths(v, key + "." + std::string(k.str()));
+  } else if (auto* str = node.as_string(); str && isPathKey(key)) {
+    const std::string path = str->get();
+    if (!path.empty() && path.find('\0') == std::string::npos && !std::filesystem::path(path).is_absolute())
+      str->get() = std::filesystem::absolute(path).lexically_normal().string();
+  }
+}
+}  // namespace
+
 void applyOverride(toml::table& table, const std::string& assignment) {
   const std::string shown = printable(assignment);
   if (assignment.size() > kMaxConfigBytes)
@@ -399,6 +624,7 @@ void applyOverride(toml::table& table, const std::string& assignment) {
     const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
     if (part.empty()) throw InputError(fmt::format("--set {}: empty component in key \"{}\"", shown, printable(key)));
     if (dot == std::string::npos) {
+      absolutizePaths(*parsed.get("v"), key);
       cur->insert_or_assign(part, *parsed.get("v"));
       return;
     }
@@ -425,19 +651,15 @@ void setOutputDir(toml::table& table, const std::string& dir) {
 }
 
 lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) {
-  static const std::vector<std::string> sections{"sample", "contact", "test", "solver", "output"};
-  for (const auto& [k, v] : root) {
-    const std::string key(k.str());
-    if (std::find(sections.begin(), sections.end(), key) == sections.end())
-      fail(key, show(v), "unknown section; allowed: [sample], [contact], [test], [solver], [output]");
-  }
+  checkUnknownKeys(root);
   refuseNulCharacters(root, "");
   lab::RunConfig c;
 
   Section s(root, "sample");
+  c.sample.nParticlesGiven = s.raw("n_particles") != nullptr;
   c.sample.nParticles = static_cast<int>(s.integer("n_particles", c.sample.nParticles, 2, 50'000'000));
   c.sample.grading = parseGrading(s, baseDir);
-  c.sample.density = s.number("density", c.sample.density, 0.0, 1e6, true, false, "must be in (0, 1e6] [kg/m^3]");
+  c.sample.density = s.number("density", c.sample.density, 1.0, 1e6, false, false, "must be in [1, 1e6] [kg/m^3]");
   c.sample.e0 = s.number("e0", c.sample.e0, 0.0, 5.0, true, false, "must be > 0 and <= 5 (void ratio)");
   c.sample.seed = static_cast<std::uint64_t>(s.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
   if (const toml::node* n = s.raw("prep_friction_deg")) {
@@ -453,7 +675,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                        "must be in [1, 20] (loose placement before compaction)");
   c.sample.packing = resolvePath(s.string("packing", c.sample.packing, {}), baseDir);
   if (!c.sample.packing.empty() && !pathExists(c.sample.packing))
-    fail("sample.packing", quotedPath(c.sample.packing), "file not found");
+    fail("sample.packing", quotedPath(c.sample.packing), notFound(c.sample.packing));
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
@@ -464,6 +686,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
                                     "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
+  // A packing file brings its own grains: the grading of the run is the packing's.
+  if (!c.sample.packing.empty()) c.sample.grading = lab::GradingConfig{.type = "packing", .diameters = {}, .passing = {}};
   if (c.sample.latticeJitter > 0.0 && c.sample.method != "lattice")
     fail("sample.lattice_jitter", fmt::format("{}", c.sample.latticeJitter), "applies to sample.method = \"lattice\" only");
   if (c.sample.method == "lattice") {
@@ -483,7 +707,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
 
   Section ct(root, "contact");
   c.contact.model = ct.string("model", c.contact.model, {"kozicki", "rolling-linear"});
-  c.contact.young = ct.number("young", c.contact.young, 0.0, 1e15, true, false, "must be > 0 [Pa]");
+  c.contact.young = ct.number("young", c.contact.young, 1e3, 1e15, false, false, "must be in [1e3, 1e15] [Pa]");
   c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 1.0, false, false, "must be in [0, 1] (Ks = poisson * Kn)");
   c.contact.frictionDeg = ct.number("friction_deg", c.contact.frictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   c.contact.beta = ct.number("beta", c.contact.beta, 0.0, 1e6, false, false, "must be >= 0");
@@ -491,7 +715,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.contact.wallFrictionDeg = ct.number("wall_friction_deg", c.contact.wallFrictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   c.contact.momentLimit = ct.string("moment_limit", c.contact.momentLimit, {"mean-radius", "yade"});
   if (ct.raw("kn"))
-    c.contact.kn = ct.number("kn", 0.0, 0.0, 1e15, true, false, "must be > 0 [N/m] (a constant normal stiffness)");
+    c.contact.kn = ct.number("kn", 0.0, 1e-3, 1e15, false, false, "must be in [1e-3, 1e15] [N/m] (a constant normal stiffness)");
   const bool linear = c.contact.model == "rolling-linear";
   const toml::node* mu = ct.raw("rolling_friction");
   const toml::node* sph = ct.raw("sphericity");
@@ -514,15 +738,16 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     const toml::node* file = t.get("file");
     if (!file || !file->is_string()) fail(key + ".file", file ? show(*file) : "(missing)", "a path to a CSV of sphericities is required");
     sc.file = resolvePath(file->value<std::string>().value(), baseDir);
-    if (!pathExists(sc.file)) fail(key + ".file", show(*file), "file not found");
+    if (!pathExists(sc.file)) fail(key + ".file", show(*file), notFound(sc.file));
     if (const toml::node* cn = t.get("c")) {
-      if (!cn->is_number() || !(numberOf(*cn) > 0.0) || !std::isfinite(numberOf(*cn)))
-        fail(key + ".c", show(*cn), "must be a finite number > 0");
+      if (!cn->is_number() || !(numberOf(*cn) > 0.0) || !std::isfinite(numberOf(*cn)) || subnormal(numberOf(*cn)))
+        fail(key + ".c", show(*cn), "must be a finite, normal number > 0 (mu_r = c psi^k)");
       sc.c = numberOf(*cn);
     }
     const toml::node* kn = t.get("k");
     if (!kn) fail(key + ".k", "(missing)", "the exponent k of mu_r = c psi^k has no default and must be given");
-    if (!kn->is_number() || !std::isfinite(numberOf(*kn))) fail(key + ".k", show(*kn), "must be a finite number");
+    if (!kn->is_number() || !std::isfinite(numberOf(*kn)) || subnormal(numberOf(*kn)))
+      fail(key + ".k", show(*kn), "must be a finite, normal number (mu_r = c psi^k)");
     sc.k = numberOf(*kn);
     if (const toml::node* cb = t.get("combine")) {
       const std::string v = cb->is_string() ? cb->value<std::string>().value() : "";
@@ -538,7 +763,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
   if (c.test.type == "simple-shear" && c.test.boundary != "periodic")
     fail("test.type", "\"simple-shear\"", "needs test.boundary = \"periodic\" (a wall box has no shearing walls)");
-  c.test.confiningPressure = t.number("confining_pressure", c.test.confiningPressure, 0.0, 1e10, true, false, "must be > 0 [Pa]");
+  c.test.confiningPressure = t.number("confining_pressure", c.test.confiningPressure, 1.0, 1e10, false, false, "must be in [1, 1e10] [Pa]");
   if (const toml::node* n = t.raw("axial_strain_rate")) {
     if (n->is_string() && n->value<std::string>().value() == "auto") {
       c.test.axialStrainRate.reset();
@@ -547,7 +772,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                         "must be \"auto\" or a rate > 0 [1/s]");
     }
   }
-  c.test.finalAxialStrain = t.number("final_axial_strain", c.test.finalAxialStrain, 0.0, 0.5, true, false, "must be in (0, 0.5]");
+  c.test.finalAxialStrain = t.number("final_axial_strain", c.test.finalAxialStrain, 1e-4, 0.5, false, false, "must be in [1e-4, 0.5]");
   c.test.b = t.number("b", c.test.b, 0.0, 1.0, false, false, "must be in [0, 1] ((sigma2 - sigma3)/(sigma1 - sigma3))");
   if (const toml::node* n = t.raw("shear_strain_rate")) {
     if (n->is_string() && n->value<std::string>().value() == "auto") {
@@ -557,7 +782,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
                                         "must be \"auto\" or a rate > 0 [1/s]");
     }
   }
-  c.test.finalShearStrain = t.number("final_shear_strain", c.test.finalShearStrain, 0.0, 2.0, true, false, "must be in (0, 2]");
+  c.test.finalShearStrain = t.number("final_shear_strain", c.test.finalShearStrain, 1e-4, 2.0, false, false, "must be in [1e-4, 2]");
   c.test.probeStrain = t.number("probe_strain", c.test.probeStrain, 0.0, 1e-3, false, false,
                                 "must be in [0, 1e-3] (axial strain of the small-strain probe; 0: no probe)");
   if (const toml::node* n = t.raw("unload_reload_at")) {
@@ -604,22 +829,42 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   Section o(root, "output");
   c.output.dir = o.string("dir", c.output.dir, {});
   if (c.output.dir.empty()) fail("output.dir", "\"\"", "must be a non-empty path");
-  c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 0.0, 0.1, true, false, "must be in (0, 0.1]");
+  c.output.recordEveryStrain = o.number("record_every_strain", c.output.recordEveryStrain, 1e-6, 0.1, false, false, "must be in [1e-6, 0.1]");
   c.output.plots = o.boolean("plots", c.output.plots);
   c.output.savePacking = o.boolean("save_packing", c.output.savePacking);
   c.output.checkpointEvery = o.number("checkpoint_every", c.output.checkpointEvery, 0.0, 1.0, false, false,
-                                      "must be in [0, 1] (axial strain between checkpoints; 0: none)");
+                                      "must be 0 or in [1e-4, 1] (axial strain between checkpoints; 0: none)");
+  if (c.output.checkpointEvery > 0.0 && c.output.checkpointEvery < 1e-4)
+    fail("output.checkpoint_every", fmt::format("{}", c.output.checkpointEvery), "must be 0 or in [1e-4, 1] (a checkpoint every step is no checkpoint)");
   c.output.vtkEveryStrain = o.number("vtk_every_strain", c.output.vtkEveryStrain, 0.0, 1.0, false, false,
-                                     "must be in [0, 1] (0: no VTK snapshots)");
+                                     "must be 0 or in [1e-4, 1] (0: no VTK snapshots)");
+  if (c.output.vtkEveryStrain > 0.0 && c.output.vtkEveryStrain < 1e-4)
+    fail("output.vtk_every_strain", fmt::format("{}", c.output.vtkEveryStrain), "must be 0 or in [1e-4, 1] (at most 10 000 snapshots per unit strain)");
   c.output.microSnapshots = o.boolean("micro_snapshots", c.output.microSnapshots);
   c.output.bandFactor = o.number("band_factor", c.output.bandFactor, 1.0, 100.0, true, false,
                                  "must be in (1, 100] (a grain is in the shear band when its local shear strain "
                                  "is at least this times the box's)");
   o.finish();
+  // Cross-key checks, after every key of every section is known and in range.
+  if (c.sample.method == "lattice" && c.sample.packing.empty()) {
+    const lab::GradingConfig& g = c.sample.grading;
+    const double spread = g.type == "curve" ? g.diameters.back() / g.diameters.front() : g.type == "uniform" ? g.dMax / g.dMin : 1.0;
+    if (spread > 1.01)
+      fail("sample.grading", g.type == "curve" ? fmt::format("{{ type = \"curve\", {:g} to {:g} m }}", g.diameters.front(), g.diameters.back())
+                                               : fmt::format("{{ type = \"uniform\", d_min = {:g}, d_max = {:g} }}", g.dMin, g.dMax),
+           "sample.method = \"lattice\" places equal spheres (the grading's d50): allowed a grading of one size, d_max <= "
+           "1.01 d_min, e.g. { type = \"uniform\", d_min = 2e-3, d_max = 2e-3 }");
+  }
+  refuseInapplicable(root, c);
   return c;
 }
 
 toml::table resolvedTable(const lab::RunConfig& c) {
+  // Only the keys that apply (inapplicable(): the others are refused in a config), so that the
+  // resolved config is itself a valid config and records what ran.
+  auto put = [&c](toml::table& t, const std::string& section, const char* key, auto&& value) {
+    if (inapplicable(c, section + "." + key).empty()) t.insert(key, std::forward<decltype(value)>(value));
+  };
   toml::table grading;
   grading.insert("type", c.sample.grading.type);
   if (c.sample.grading.type == "curve") {
@@ -631,71 +876,70 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   } else if (c.sample.grading.type == "uniform") {
     grading.insert("d_min", c.sample.grading.dMin);
     grading.insert("d_max", c.sample.grading.dMax);
-  } else {
+  } else if (c.sample.grading.type == "list") {
     grading.insert("file", c.sample.grading.file);
   }
-  toml::table sample{
-      {"n_particles", c.sample.nParticles},
-      {"grading", grading},
-      {"density", c.sample.density},
-      {"e0", c.sample.e0},
-      {"seed", static_cast<std::int64_t>(c.sample.seed)},
-      {"e0_tolerance", c.sample.e0Tolerance},
-      {"initial_void_ratio", c.sample.initialVoidRatio},
-      {"prep_stiffness_factor", c.sample.prepStiffnessFactor},
-      {"prep_damping", c.sample.prepDamping},
-      {"packing", c.sample.packing},
-      {"prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps)},
-      {"method", c.sample.method},
-      {"growth_rate", c.sample.growthRate},
-      {"lattice_jitter", c.sample.latticeJitter},
-      {"shape", toml::table{{"type", c.sample.shape.type},
-                            {"elongation", c.sample.shape.elongation},
-                            {"flatness", c.sample.shape.flatness},
-                            {"orientation", c.sample.shape.orientation},
-                            {"fraction", c.sample.shape.fraction},
-                            {"eccentricity_step", c.sample.shape.eccentricityStep}}},
-  };
-  if (c.sample.prepFrictionDeg) sample.insert("prep_friction_deg", *c.sample.prepFrictionDeg);
-  else sample.insert("prep_friction_deg", "auto");
-  toml::table contact{{"model", c.contact.model},       {"young", c.contact.young},
-                      {"poisson", c.contact.poisson},   {"friction_deg", c.contact.frictionDeg},
-                      {"beta", c.contact.beta},         {"eta", c.contact.eta},
-                      {"wall_friction_deg", c.contact.wallFrictionDeg},
-                      {"moment_limit", c.contact.momentLimit}};
+  toml::table shape{{"type", c.sample.shape.type}};
+  for (const auto& [k, v] : {std::pair<const char*, double>{"elongation", c.sample.shape.elongation},
+                             {"flatness", c.sample.shape.flatness},
+                             {"fraction", c.sample.shape.fraction},
+                             {"eccentricity_step", c.sample.shape.eccentricityStep}})
+    put(shape, "sample.shape", k, v);
+  put(shape, "sample.shape", "orientation", c.sample.shape.orientation);
+  toml::table sample{{"n_particles", c.sample.nParticles},
+                     {"grading", grading},
+                     {"density", c.sample.density},
+                     {"seed", static_cast<std::int64_t>(c.sample.seed)},
+                     {"packing", c.sample.packing}};
+  put(sample, "sample", "e0", c.sample.e0);
+  put(sample, "sample", "e0_tolerance", c.sample.e0Tolerance);
+  put(sample, "sample", "initial_void_ratio", c.sample.initialVoidRatio);
+  put(sample, "sample", "prep_stiffness_factor", c.sample.prepStiffnessFactor);
+  put(sample, "sample", "prep_damping", c.sample.prepDamping);
+  put(sample, "sample", "prep_ramp_steps", static_cast<std::int64_t>(c.sample.prepRampSteps));
+  put(sample, "sample", "method", c.sample.method);
+  put(sample, "sample", "growth_rate", c.sample.growthRate);
+  put(sample, "sample", "lattice_jitter", c.sample.latticeJitter);
+  put(sample, "sample", "shape", shape);
+  if (c.sample.prepFrictionDeg) put(sample, "sample", "prep_friction_deg", *c.sample.prepFrictionDeg);
+  else put(sample, "sample", "prep_friction_deg", "auto");
+  toml::table contact{{"model", c.contact.model},
+                      {"poisson", c.contact.poisson},
+                      {"friction_deg", c.contact.frictionDeg}};
+  put(contact, "contact", "young", c.contact.young);
+  put(contact, "contact", "beta", c.contact.beta);
+  put(contact, "contact", "eta", c.contact.eta);
+  put(contact, "contact", "wall_friction_deg", c.contact.wallFrictionDeg);
+  put(contact, "contact", "moment_limit", c.contact.momentLimit);
   if (c.contact.kn) contact.insert("kn", *c.contact.kn);
-  if (c.contact.model == "rolling-linear") {
-    if (c.contact.sphericity) {
-      const auto& sc = *c.contact.sphericity;
-      contact.insert("sphericity", toml::table{{"file", sc.file}, {"c", sc.c}, {"k", sc.k}, {"combine", sc.combine}});
-    } else {
-      contact.insert("rolling_friction", c.contact.rollingFriction);
-    }
+  if (c.contact.sphericity) {
+    const auto& sc = *c.contact.sphericity;
+    put(contact, "contact", "sphericity", toml::table{{"file", sc.file}, {"c", sc.c}, {"k", sc.k}, {"combine", sc.combine}});
+  } else {
+    put(contact, "contact", "rolling_friction", c.contact.rollingFriction);
   }
   toml::table test{{"type", c.test.type},
                    {"boundary", c.test.boundary},
                    {"confining_pressure", c.test.confiningPressure},
-                   {"final_axial_strain", c.test.finalAxialStrain},
-                   {"b", c.test.b},
-                   {"final_shear_strain", c.test.finalShearStrain}};
-  if (c.test.axialStrainRate) test.insert("axial_strain_rate", *c.test.axialStrainRate);
-  else test.insert("axial_strain_rate", "auto");
-  test.insert("probe_strain", c.test.probeStrain);
+                   {"probe_strain", c.test.probeStrain}};
+  put(test, "test", "final_axial_strain", c.test.finalAxialStrain);
+  put(test, "test", "b", c.test.b);
+  put(test, "test", "final_shear_strain", c.test.finalShearStrain);
+  if (c.test.axialStrainRate) put(test, "test", "axial_strain_rate", *c.test.axialStrainRate);
+  else put(test, "test", "axial_strain_rate", "auto");
   if (!c.test.unloadReloadAt.empty()) {
     toml::array at;
     for (double v : c.test.unloadReloadAt) at.push_back(v);
     test.insert("unload_reload_at", at);
   }
-  test.insert("unload_to_q_fraction", c.test.unloadToQFraction);
-  test.insert("loop_rest", c.test.loopRest);
-  test.insert("platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
-  test.insert("servo_max_speed", c.test.servoMaxSpeed);
-  if (c.test.shearStrainRate) test.insert("shear_strain_rate", *c.test.shearStrainRate);
-  else test.insert("shear_strain_rate", "auto");
-  toml::table solver{{"damping", c.solver.damping},
-                     {"viscous_damping", c.solver.viscousDamping},
+  put(test, "test", "unload_to_q_fraction", c.test.unloadToQFraction);
+  put(test, "test", "loop_rest", c.test.loopRest);
+  put(test, "test", "platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
+  put(test, "test", "servo_max_speed", c.test.servoMaxSpeed);
+  if (c.test.shearStrainRate) put(test, "test", "shear_strain_rate", *c.test.shearStrainRate);
+  else put(test, "test", "shear_strain_rate", "auto");
+  toml::table solver{{"viscous_damping", c.solver.viscousDamping},
                      {"dt_factor", c.solver.dtFactor},
-                     {"force_dt", c.solver.forceDt},
                      {"threads", c.solver.threads},
                      {"unbalanced_tolerance", c.solver.unbalancedTolerance},
                      {"stress_tolerance", c.solver.stressTolerance},
@@ -704,15 +948,17 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                      {"servo_max_speed", c.solver.servoMaxSpeed},
                      {"skin_fraction", c.solver.skinFraction},
                      {"max_steps", static_cast<std::int64_t>(c.solver.maxSteps)}};
+  put(solver, "solver", "damping", c.solver.damping);
+  put(solver, "solver", "force_dt", c.solver.forceDt);
   if (c.solver.dt) solver.insert("dt", *c.solver.dt);
   toml::table output{{"dir", c.output.dir},
-                     {"record_every_strain", c.output.recordEveryStrain},
                      {"plots", c.output.plots},
                      {"save_packing", c.output.savePacking},
-                     {"vtk_every_strain", c.output.vtkEveryStrain},
-                     {"micro_snapshots", c.output.microSnapshots},
-                     {"checkpoint_every", c.output.checkpointEvery},
-                     {"band_factor", c.output.bandFactor}};
+                     {"vtk_every_strain", c.output.vtkEveryStrain}};
+  put(output, "output", "record_every_strain", c.output.recordEveryStrain);
+  put(output, "output", "micro_snapshots", c.output.microSnapshots);
+  put(output, "output", "checkpoint_every", c.output.checkpointEvery);
+  put(output, "output", "band_factor", c.output.bandFactor);
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
                      {"solver", solver}, {"output", output}};
 }

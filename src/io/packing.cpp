@@ -11,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "io/input_file.hpp"
+#include "lab/run_config.hpp"
 
 namespace grainlab::io {
 
@@ -352,6 +353,107 @@ PackingData packingFromSimulation(const Simulation& sim, const std::string& comm
     q.orientation = P.orientation[i];
   }
   return p;
+}
+
+void checkPackingGeometry(const PackingData& p, const std::string& subject) {
+  const std::size_t n = p.particles.size();
+  if (n == 0) return;
+  // Box or cell widths (a cell: its volume over the area of each pair of edges).
+  Vec3 width;
+  if (p.periodic) {
+    const double volume = p.cell.determinant();
+    for (int k = 0; k < 3; ++k)
+      width[k] = volume / p.cell.col((k + 1) % 3).cross(p.cell.col((k + 2) % 3)).norm();
+  } else {
+    for (int k = 0; k < 3; ++k) width[k] = p.walls[2 * k + 1] - p.walls[2 * k];
+  }
+  double inscribedMax = 0.0;
+  for (const PackedParticle& q : p.particles) {
+    const double a = q.semiAxes[0], c = q.semiAxes[2];
+    if (!(2.0 * c >= lab::kMinDiameter && 2.0 * a <= lab::kMaxDiameter))
+      throw InputError(fmt::format("{}: particle id {}: semi-axes ({:g}, {:g}, {:g}) m; allowed: diameters in [{:g}, {:g}] m",
+                                   subject, q.id, q.semiAxes[0], q.semiAxes[1], c, lab::kMinDiameter, lab::kMaxDiameter));
+    if (!(2.0 * a < width.minCoeff()))
+      throw InputError(fmt::format("{}: particle id {}: its size 2a = {:g} m is not smaller than its {} (smallest width "
+                                   "{:g} m); allowed: grains smaller than the box",
+                                   subject, q.id, 2.0 * a, p.periodic ? "cell" : "box of walls", width.minCoeff()));
+    inscribedMax = std::max(inscribedMax, c);
+  }
+  // Grid of cells at least 2 x the largest inscribed radius wide (pairs that overlap are in
+  // neighbouring cells), in fractional coordinates of the box or cell, at most ~n cells.
+  const Mat3 inverse = p.periodic ? Mat3(p.cell.inverse()) : Mat3::Identity();
+  const Vec3 lo = p.periodic ? Vec3::Zero() : Vec3(p.walls[0], p.walls[2], p.walls[4]);
+  double h = 2.0 * inscribedMax;
+  std::array<long, 3> m{};
+  for (;;) {
+    double cells = 1.0;
+    for (int k = 0; k < 3; ++k) cells *= (m[k] = std::max(1L, static_cast<long>(std::floor(width[k] / h))));
+    if (cells <= 2.0 * static_cast<double>(n) + 27.0) break;
+    h *= 1.5;
+  }
+  std::vector<Vec3> frac(n);
+  std::vector<std::array<long, 3>> cellOf(n);
+  std::vector<std::size_t> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 s;
+    if (p.periodic) {
+      s = inverse * p.particles[i].position;
+      for (int k = 0; k < 3; ++k) s[k] -= std::floor(s[k]);
+    } else {
+      s = (p.particles[i].position - lo).cwiseQuotient(width);
+    }
+    frac[i] = s;
+    for (int k = 0; k < 3; ++k) cellOf[i][k] = std::clamp(static_cast<long>(s[k] * static_cast<double>(m[k])), 0L, m[k] - 1);
+    key[i] = static_cast<std::size_t>((cellOf[i][0] * m[1] + cellOf[i][1]) * m[2] + cellOf[i][2]);
+  }
+  // Counting sort of the particles by cell.
+  const std::size_t cells = static_cast<std::size_t>(m[0] * m[1] * m[2]);
+  std::vector<std::size_t> start(cells + 1, 0), order(n);
+  for (std::size_t i = 0; i < n; ++i) ++start[key[i] + 1];
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) order[fill[key[i]]++] = i;
+  }
+  auto neighbours = [&](int k, long c) {
+    std::vector<long> out;
+    for (long d = -1; d <= 1; ++d) {
+      long v = c + d;
+      if (p.periodic) v = ((v % m[k]) + m[k]) % m[k];
+      else if (v < 0 || v >= m[k]) continue;
+      if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
+    }
+    return out;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const PackedParticle& A = p.particles[i];
+    for (long x : neighbours(0, cellOf[i][0]))
+      for (long y : neighbours(1, cellOf[i][1]))
+        for (long z : neighbours(2, cellOf[i][2])) {
+          const std::size_t c = static_cast<std::size_t>((x * m[1] + y) * m[2] + z);
+          for (std::size_t o = start[c]; o < start[c + 1]; ++o) {
+            const std::size_t j = order[o];
+            if (j <= i) continue;
+            const PackedParticle& B = p.particles[j];
+            Vec3 d;
+            if (p.periodic) {
+              Vec3 ds = frac[j] - frac[i];
+              for (int k = 0; k < 3; ++k) ds[k] -= std::round(ds[k]);
+              d = p.cell * ds;
+            } else {
+              d = B.position - A.position;
+            }
+            const double ra = A.semiAxes[2], rb = B.semiAxes[2];
+            const double overlap = ra + rb - d.norm();
+            if (overlap > kMaxPackingOverlap * std::min(ra, rb))
+              throw InputError(fmt::format(
+                  "{}: particles id {} and id {} overlap by {:.3g} m ({:.3g} of the smaller {}radius {:.6g} m{}); allowed: "
+                  "overlaps up to {} of the smaller radius (a packing in equilibrium)",
+                  subject, A.id, B.id, overlap, overlap / std::min(ra, rb), A.ellipsoid || B.ellipsoid ? "inscribed " : "",
+                  std::min(ra, rb), d.norm() == 0.0 ? ", coincident centres" : "", kMaxPackingOverlap));
+          }
+        }
+  }
 }
 
 void simulationFromPacking(const PackingData& p, double density, Simulation& sim, const std::string& subject) {

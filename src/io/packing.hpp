@@ -61,6 +61,16 @@ PackingData readPackingFile(const std::filesystem::path& file, const std::string
 // The same for text in memory; `subject` starts every message.
 PackingData parsePacking(std::string_view text, const std::string& subject);
 
+// Largest overlap a packing may hold between two grains, as a fraction of the smaller radius (of
+// their inscribed spheres, c for an ellipsoid): a packing in equilibrium at any pressure overlaps
+// far less; coincident centres are refused always.
+inline constexpr double kMaxPackingOverlap = 0.1;
+// Refuses a packing that no run can start from: a grain outside the diameter bounds of
+// lab::kMinDiameter..kMaxDiameter, a grain as large as its box or cell, and two grains overlapping
+// by more than kMaxPackingOverlap (found with a spatial grid, O(n)). Messages name `subject`, the
+// particle ids and what is allowed.
+void checkPackingGeometry(const PackingData& packing, const std::string& subject);
+
 // The grains (persistent ids, shapes, orientations) and the walls or cell of a simulation.
 PackingData packingFromSimulation(const Simulation& sim, const std::string& comment);
 // Replaces the particles and the boundary (walls or periodic cell) of `sim` with those of the

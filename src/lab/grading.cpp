@@ -34,6 +34,7 @@ std::vector<double> readDiameterList(const std::string& path) {
   std::vector<double> out;
   std::size_t pos = 0;
   int lineNo = 0;
+  bool header = false;  // the optional header line is past
   while (pos < text.size()) {
     const std::size_t nl = std::min(text.find('\n', pos), text.size());
     const std::string_view line(text.data() + pos, nl - pos);
@@ -45,10 +46,16 @@ std::vector<double> readDiameterList(const std::string& path) {
     field = field.substr(b, field.find_last_not_of(" \t\r") - b + 1);
     bool numeric = false;
     const std::optional<double> d = listNumber(field, numeric);
-    if (!numeric && lineNo == 1) continue;  // a header row
-    if (!d || !(*d > 0.0))
-      throw InputError(fmt::format("{}: line {}: \"{}\" is not a finite diameter > 0 [m]", subject, lineNo,
-                                   io::printable(field)));
+    // The one optional header: the first line that is not blank or a comment, if it has no digit at
+    // all (e.g. "diameter_m"); "0.003abc" is a bad diameter, never a header.
+    if (out.empty() && !header && field.find_first_of("0123456789") == std::string_view::npos) {
+      header = true;
+      continue;
+    }
+    header = true;
+    if (!d || !(*d >= kMinDiameter && *d <= kMaxDiameter))
+      throw InputError(fmt::format("{}: line {}: \"{}\" is not a diameter in [{:g}, {:g}] m", subject, lineNo,
+                                   io::printable(field), kMinDiameter, kMaxDiameter));
     out.push_back(*d);
   }
   if (out.empty()) throw InputError(fmt::format("{}: no diameters found", subject));

@@ -15,8 +15,10 @@ namespace grainlab::lab {
 std::vector<double> sampleDiameters(const GradingConfig& grading, int n, Rng& rng);
 
 // The diameters [m] of a list file (sample.grading type "list"): one per line, the first field of a
-// CSV row; an optional header row and '#' comments. Every value must be a finite number > 0; throws
-// InputError naming the file and line. The file is read within io::kMaxListFileBytes.
+// CSV row; blank lines and '#' comments skipped; one optional header, the first other line, only if
+// it holds no digit at all ("diameter_m"; "0.003abc" is a bad diameter). Every value must be a
+// diameter in [kMinDiameter, kMaxDiameter]; throws InputError naming the file and line. The file is
+// read within io::kMaxListFileBytes.
 std::vector<double> readDiameterList(const std::string& path);
 
 // Characteristic diameters of a set of spheres, by mass (as a sieve analysis would give).

@@ -68,33 +68,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
 
 PreparationResult Laboratory::prepare() {
   PreparationResult result;
-  Rng rng(config_.sample.seed);
-  const std::vector<double> diameters = sampleDiameters(config_.sample.grading, config_.sample.nParticles, rng);
-  result.grading = gradingStats(diameters);
-  d50_ = result.grading.d50;
-  if (config_.sample.method == "lattice") {
-    // Equal spheres of the grading's d50 ([O]'s N = n^3 equal grains).
-    const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(config_.sample.nParticles))));
-    placeLattice(n, result.grading.d50, config_.sample.density, sim_);
-    result.grading = gradingStats(std::vector<double>(sim_.particles.size(), result.grading.d50));
-    d50_ = result.grading.d50;
-  } else {
-    placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng, sim_);
-  }
-  records_ = GrainRecords{};
-  records_.sphericity = assignRollingFriction(config_, sim_.particles);
-  configureSolver(config_, sim_);
-  if (sim_.boundary == Boundary::Periodic) {
-    const double need = sim_.broadPhase.minimumCellWidth(sim_.particles);
-    // The cell shrinks to roughly (1 + e) / (1 + e_placement) of its volume; refuse up front what the
-    // broad phase would refuse later.
-    const double expected = sim_.cell.widths().minCoeff() * std::cbrt(1.6 / (1.0 + config_.sample.initialVoidRatio));
-    if (expected < need)
-      throw InputError(fmt::format(
-          "config error: sample.n_particles = {}: too few for a periodic cell (its side would be ~{:.3g} m, "
-          "under twice the interaction range {:.3g} m); allowed: enough particles for >= ~3 largest "
-          "diameters per side", config_.sample.nParticles, expected, need));
-  }
+  placeSample(result);
   const Simulation loose = sim_;
 
   const double target = config_.sample.e0;
@@ -166,6 +140,36 @@ PreparationResult Laboratory::prepare() {
   return result;
 }
 
+void Laboratory::placeSample(PreparationResult& result) {
+  Rng rng(config_.sample.seed);
+  const std::vector<double> diameters = sampleDiameters(config_.sample.grading, config_.sample.nParticles, rng);
+  result.grading = gradingStats(diameters);
+  d50_ = result.grading.d50;
+  if (config_.sample.method == "lattice") {
+    // Equal spheres of the grading's d50 ([O]'s N = n^3 equal grains).
+    const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(config_.sample.nParticles))));
+    placeLattice(n, result.grading.d50, config_.sample.density, sim_);
+    result.grading = gradingStats(std::vector<double>(sim_.particles.size(), result.grading.d50));
+    d50_ = result.grading.d50;
+  } else {
+    placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng, sim_);
+  }
+  records_ = GrainRecords{};
+  records_.sphericity = assignRollingFriction(config_, sim_.particles);
+  configureSolver(config_, sim_);
+  if (sim_.boundary == Boundary::Periodic) {
+    const double need = sim_.broadPhase.minimumCellWidth(sim_.particles);
+    // The cell shrinks to roughly (1 + e) / (1 + e_placement) of its volume; refuse up front what the
+    // broad phase would refuse later.
+    const double expected = sim_.cell.widths().minCoeff() * std::cbrt(1.6 / (1.0 + config_.sample.initialVoidRatio));
+    if (expected < need)
+      throw InputError(fmt::format(
+          "config error: sample.n_particles = {}: too few for a periodic cell (its side would be ~{:.3g} m, "
+          "under twice the interaction range {:.3g} m); allowed: enough particles for >= ~3 largest "
+          "diameters per side", config_.sample.nParticles, expected, need));
+  }
+}
+
 long Laboratory::growShapes() {
   const ShapeConfig& shape = config_.sample.shape;
   const double density = config_.sample.density;
@@ -222,6 +226,20 @@ long Laboratory::growShapes() {
   }
   sim_.model.tanFriction = friction;
   return steps;
+}
+
+void Laboratory::checkSample(const Simulation* packed) {
+  if (!packed) {
+    PreparationResult result;
+    placeSample(result);
+    return;
+  }
+  sim_ = *packed;
+  assignRollingFriction(config_, sim_.particles);
+  std::vector<double> diameters(sim_.particles.size());
+  for (std::size_t i = 0; i < diameters.size(); ++i) diameters[i] = 2.0 * sim_.particles.equivalentRadius[i];
+  d50_ = gradingStats(diameters).d50;
+  configureSolver(config_, sim_);
 }
 
 PreparationResult Laboratory::adoptPacking(Simulation packed) {

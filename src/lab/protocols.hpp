@@ -111,6 +111,12 @@ class Laboratory {
   // preparation friction, searched when not given, or frictionless growth), then re-equilibrates at
   // full stiffness with friction restored.
   PreparationResult prepare();
+  // The checks prepare() or adoptPacking() make before their first step (the sample drawn and
+  // placed, or the packing taken, and the solver configured: the time step against the critical
+  // one, the size of a periodic cell), without preparing: `check` and `run` make them up front
+  // (lab/preflight.hpp). Leaves simulation() and d50() as that first step would see them.
+  void checkSample(const Simulation* packed);
+  double d50() const { return d50_; }
   // Starts from a given packing (particles and boundary already in `packed`): equilibrium at full
   // stiffness and friction at the confining pressure, no compaction and no e0 search.
   PreparationResult adoptPacking(Simulation packed);
@@ -217,6 +223,7 @@ class Laboratory {
   MicroAnalyzer micro_;
   MicroColumnSet microColumns_;
   double d50_ = 0.0;
+  void placeSample(PreparationResult& result);
   std::vector<GrowthStage> growthCurve_;  // of the last growShapes(); preparation only, not in checkpoints
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();

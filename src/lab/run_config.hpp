@@ -10,8 +10,16 @@
 
 namespace grainlab::lab {
 
+// Practical bounds of a grain diameter [m] (gradings, list files, packings): a grain below a
+// micrometre or above 10 m is no test of this engine (its masses, stiffnesses and time steps leave
+// the range a run resolves); refused with these bounds stated.
+inline constexpr double kMinDiameter = 1e-6;
+inline constexpr double kMaxDiameter = 10.0;
+
 struct GradingConfig {
-  std::string type = "curve";  // "curve" (percent passing by mass), "uniform" (by number), "list"
+  // "curve" (percent passing by mass), "uniform" (by number), "list"; "packing": the grading of
+  // sample.packing, as config.resolved.toml records a run from a packing file
+  std::string type = "curve";
   std::vector<double> diameters{2.0e-3, 8.0e-3};  // [m] (curve)
   std::vector<double> passing{0.0, 100.0};        // [%] by mass (curve)
   double dMin = 2.0e-3;                           // [m] (uniform)
@@ -32,6 +40,7 @@ struct ShapeConfig {
 
 struct SampleConfig {
   int nParticles = 2000;
+  bool nParticlesGiven = false;  // given in the config (with sample.packing it must match the packing)
   GradingConfig grading;
   double density = 2600.0;   // [kg/m^3]
   double e0 = 0.60;          // target initial void ratio
@@ -147,6 +156,9 @@ struct OutputConfig {
 };
 
 struct RunConfig {
+  // Keys given that were ignored (preparation keys beside sample.packing), one message each; not
+  // part of the resolved config.
+  std::vector<std::string> warnings;
   SampleConfig sample;
   ContactConfig contact;
   TestConfig test;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cfloat>
 #include <numeric>
 #include <sstream>
 
@@ -65,12 +66,15 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
     };
     if (psiCol >= 0) {
       const double psi = number(psiCol, "sphericity");
-      if (!(psi > 0.0)) throw fail(lineNo, fmt::format("sphericity {} must be > 0", psi));
+      if (!(psi > 0.0) || psi < DBL_MIN) throw fail(lineNo, fmt::format("sphericity {} must be > 0 (a normal number, >= 2.2e-308)", psi));
       d.values.push_back(psi);
+      d.lines.push_back(lineNo);
     } else {
       const double lo = number(lowCol, "bin_low"), hi = number(highCol, "bin_high"), fr = number(freqCol, "frequency");
-      if (!(lo > 0.0) || !(hi > lo)) throw fail(lineNo, fmt::format("bin [{}, {}) must satisfy 0 < bin_low < bin_high", lo, hi));
-      if (fr < 0.0) throw fail(lineNo, fmt::format("frequency {} must be >= 0", fr));
+      if (!(lo >= DBL_MIN) || !(hi > lo))
+        throw fail(lineNo, fmt::format("bin [{}, {}) must satisfy 0 < bin_low < bin_high (bin_low a normal number >= 2.2e-308)", lo, hi));
+      if (fr < 0.0 || (fr > 0.0 && fr < DBL_MIN)) throw fail(lineNo, fmt::format("frequency {} must be >= 0 (0 or a normal number)", fr));
+      d.lines.push_back(lineNo);
       d.binLow.push_back(lo);
       d.binHigh.push_back(hi);
       d.frequency.push_back(fr);
@@ -80,6 +84,24 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
   if (d.isHistogram() && std::accumulate(d.frequency.begin(), d.frequency.end(), 0.0) <= 0.0)
     throw fail(0, "all frequencies are zero");
   return d;
+}
+
+void checkRollingFriction(const SphericityDistribution& d, double c, double k, const std::string& path,
+                          const std::string& key) {
+  auto check = [&](double psi, std::size_t row) {
+    const double mu = rollingFrictionFromSphericity(psi, c, k);
+    if (std::isfinite(mu) && (mu == 0.0 || mu >= DBL_MIN) && mu <= kMaxRollingFriction) return;
+    throw InputError(fmt::format(
+        "config error: {} = {}: line {}: sphericity {} gives mu_r = c psi^k = {} x {}^{} = {}; allowed: c and k "
+        "(contact.sphericity.c, contact.sphericity.k) for which every grain's mu_r is a finite, normal number in [0, {}]",
+        key, io::quotedPath(path), d.lines.at(row), psi, c, std::min(psi, 1.0), k, mu, kMaxRollingFriction));
+  };
+  for (std::size_t i = 0; i < d.values.size(); ++i) check(d.values[i], i);
+  for (std::size_t i = 0; i < d.frequency.size(); ++i) {
+    if (d.frequency[i] == 0.0) continue;  // a bin never drawn
+    check(d.binLow[i], i);
+    check(d.binHigh[i], i);
+  }
 }
 
 std::vector<double> sampleSphericity(const SphericityDistribution& d, std::size_t n, Rng& rng) {

@@ -15,6 +15,7 @@ struct SphericityDistribution {
   std::vector<double> values;            // a list of measured sphericities, or
   std::vector<double> binLow, binHigh;   // a histogram: bins [low, high) with
   std::vector<double> frequency;         // their (relative or absolute) frequencies
+  std::vector<int> lines;                // the file's line of each value or bin
   bool isHistogram() const { return !frequency.empty(); }
 };
 
@@ -30,5 +31,13 @@ std::vector<double> sampleSphericity(const SphericityDistribution& d, std::size_
 inline double rollingFrictionFromSphericity(double psi, double c, double k) {
   return c * std::pow(std::min(psi, 1.0), k);
 }
+
+// Largest rolling friction mu_r = c psi^k of a grain (as contact.rolling_friction allows).
+inline constexpr double kMaxRollingFriction = 10.0;
+// Refuses a distribution for which mu_r = c psi^k is not finite, not normal or above
+// kMaxRollingFriction for some value (or bin end: mu_r is monotonic in psi), naming `key`, the file,
+// the line, c and k.
+void checkRollingFriction(const SphericityDistribution& d, double c, double k, const std::string& path,
+                          const std::string& key);
 
 }  // namespace grainlab::lab

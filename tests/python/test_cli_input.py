@@ -148,7 +148,8 @@ def test_numerical_blow_up_exit_1_without_nan(grainlab, tmp_path):
 def test_packing_round_trip(grainlab, tmp_path):
     """A prepared sample is saved as packing.txt and a run can start from it."""
     cfg = INTERFACE_EXAMPLE.replace("n_particles = 2000", "n_particles = 80").replace(
-        'type = "triaxial"', 'type = "isotropic"').replace("e0 = 0.60", "e0 = 0.60\nprep_friction_deg = 10.0")
+        'type = "triaxial"', 'type = "isotropic"').replace("e0 = 0.60", "e0 = 0.60\nprep_friction_deg = 10.0").replace(
+        "axial_strain_rate = 0.5        # 1/s\n", "").replace("final_axial_strain = 0.20\n", "")  # not for isotropic
     first = tmp_path / "first"
     grainlab("run", write(tmp_path, cfg), "--out", str(first), "--quiet", "--set", "output.plots=false", check=0)
     packing = first / "packing.txt"

@@ -109,16 +109,25 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "defaults": "",
         "rolling": '[contact]\nmodel = "rolling-linear"\n',
         "sphericity": f'[contact]\nmodel = "rolling-linear"\nsphericity = {{ file = "{sphericity}", k = -4.0 }}\n',
+        # Keys printed only where they apply (config.resolved.toml and check write exactly those).
+        "growth": '[sample]\nmethod = "growth"\n',
+        "ellipsoid-a": '[sample]\nmethod = "growth"\nshape = { type = "ellipsoid", elongation = 0.7 }\n',
+        "ellipsoid-b": '[sample]\nmethod = "growth"\nshape = { type = "ellipsoid", flatness = 0.8 }\n',
+        "true-triaxial": '[test]\ntype = "true-triaxial"\n',
+        "loops": '[test]\nunload_reload_at = [0.05]\n',
+        "simple-shear": '[test]\ntype = "simple-shear"\nboundary = "periodic"\n',
+        "dt": '[solver]\ndt = 1e-7\n',
     }
     printed = {}
     for name, text in configs.items():
         path = tmp_path / f"{name}.toml"
         path.write_text(text)
         printed[name] = flatten(tomllib.loads(grainlab("check", str(path), check=0).stdout))
-    resolved = {}
+    resolved, seen = {}, {}
     for name in configs:
         for k, v in printed[name].items():
             resolved.setdefault(k, v)
+            seen.setdefault(k, []).append(v)
     problems = []
     for key, cell in documented_keys().items():
         if cell == "—":
@@ -131,7 +140,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         value = tomllib.loads("v = " + literal.group(1))["v"]
         if key not in resolved:
             problems.append(f"{key}: documented default {literal.group(1)}, not printed by check")
-        elif resolved[key] != value:
+        elif value not in seen[key]:
             problems.append(f"{key}: documented default {literal.group(1)}, check prints {resolved[key]!r}")
     documented = documented_keys()
     for key in printed["defaults"]:

@@ -112,7 +112,9 @@ def test_run_equals_the_cli_bit_for_bit(tmp_path):
 
 def test_a_failed_run_raises_and_keeps_its_summary(tmp_path):
     with pytest.raises(grainlab.SimulationError, match="run failed: .*max_steps"):
-        grainlab.run("quick-triaxial", set={**SMALL, "solver.max_steps": 100}, out=tmp_path / "f", threads=1)
+        # A rate at which the test itself fits in 100 steps (else refused up front): the preparation fails.
+        grainlab.run("quick-triaxial", set={**SMALL, "solver.max_steps": 100, "test.axial_strain_rate": 300.0},
+                     out=tmp_path / "f", threads=1)
     assert json.loads((tmp_path / "f" / "summary.json").read_text())["status"] == "failed"
 
 
