@@ -108,18 +108,25 @@ void makePlots(const fs::path& dir, bool quiet) {
   }
 }
 
-lab::RunConfig resolveConfig(const RunOptions& opt) {
+lab::RunConfig resolveConfig(const RunOptions& opt, bool inputFilesMustExist = true) {
   toml::table table = io::loadConfigTable(opt.config);
   for (const auto& s : opt.overrides) io::applyOverride(table, s);
   if (!opt.outDir.empty()) io::setOutputDir(table, opt.outDir);
   if (opt.threads > 0) io::applyOverride(table, fmt::format("solver.threads={}", opt.threads));
-  return io::parseConfig(table, io::configBaseDir(opt.config));
+  return io::parseConfig(table, io::configBaseDir(opt.config), inputFilesMustExist);
 }
 
 }  // namespace
 
-std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
+namespace {
+// The config's warnings, printed once everything it names has been read and checked: a refused
+// input says one line, its error, and nothing else.
+void printConfigWarnings(const lab::RunConfig& config) {
   for (const auto& w : config.warnings) std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
+}
+}  // namespace
+
+std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   if (config.sample.grading.type == "list") {
     const std::vector<double> list = lab::readDiameterList(config.sample.grading.file);
     const auto [dMin, dMax] = std::minmax_element(list.begin(), list.end());
@@ -136,6 +143,7 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   }
   if (config.sample.packing.empty()) {
     lab::preflight(config, nullptr);
+    printConfigWarnings(config);
     return std::nullopt;
   }
   const io::PackingData packing = io::readPackingFile(config.sample.packing, "sample.packing");
@@ -156,6 +164,7 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
                                  io::quotedPath(config.sample.packing), periodic ? "a periodic cell" : "walls",
                                  config.test.boundary));
   lab::preflight(config, &packed);
+  printConfigWarnings(config);
   return packed;
 }
 
@@ -680,7 +689,7 @@ int resumeLab(const ResumeOptions& opt) {
       // Killed while plotting or analysing: the curves and summary are there, finish the rest.
       RunOptions resolved;
       resolved.config = (dir / "config.resolved.toml").string();
-      const lab::RunConfig config = resolveConfig(resolved);
+      const lab::RunConfig config = resolveConfig(resolved, /*inputFilesMustExist=*/false);  // never read by resume
       return inFolder(folder, [&] {
         completeResults(dir, config, done, opt.quiet, fs::exists(dir / "micro" / "snapshots.csv", ec));
         if (!opt.quiet)
@@ -695,7 +704,7 @@ int resumeLab(const ResumeOptions& opt) {
                                  io::quotedPath(opt.dir)));
   RunOptions resolved;
   resolved.config = (dir / "config.resolved.toml").string();
-  const lab::RunConfig config = resolveConfig(resolved);
+  const lab::RunConfig config = resolveConfig(resolved, /*inputFilesMustExist=*/false);  // never read by resume
   const io::Checkpoint checkpoint = io::readCheckpointFile(stateFile);
   io::checkCheckpointBelongs(checkpoint, stateFile, config, opt.allowOlderVersion);
   checkCheckpointBelongsToFolder(checkpoint.record["summary"], dir, stateFile);

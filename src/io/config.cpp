@@ -20,10 +20,36 @@ using lab::SphericityConfig;
 
 namespace {
 
+// A value as TOML would write it, floating-point numbers in their shortest exact form (0.7, not
+// toml++'s 0.69999999999999996). Nesting is bounded by checkNesting before any config is parsed.
+void writeValue(std::ostream& os, const toml::node& node) {
+  if (const auto* t = node.as_table()) {
+    os << "{ ";
+    bool first = true;
+    for (const auto& [k, v] : *t) {
+      os << (first ? "" : ", ") << k.str() << " = ";
+      writeValue(os, v);
+      first = false;
+    }
+    os << " }";
+  } else if (const auto* a = node.as_array()) {
+    os << "[";
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      if (i) os << ", ";
+      writeValue(os, *a->get(i));
+    }
+    os << "]";
+  } else if (const auto* d = node.as_floating_point()) {
+    os << fmt::format("{}", d->get());
+  } else {
+    node.visit([&](const auto& v) { os << v; });
+  }
+}
+
 // A value as the message echoes it: one line, cut to about 80 characters.
 std::string show(const toml::node& node) {
   std::ostringstream os;
-  node.visit([&](const auto& v) { os << v; });
+  writeValue(os, node);
   return printable(os.str());
 }
 
@@ -342,7 +368,7 @@ class Section {
   std::set<std::string> used_;
 };
 
-lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
+lab::GradingConfig parseGrading(Section& s, const std::string& baseDir, bool mustExist) {
   lab::GradingConfig g;
   const toml::node* node = s.raw("grading");
   if (!node) return g;
@@ -388,7 +414,7 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir) {
     const toml::node* f = get("file");
     if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
     g.file = resolvePath(f->value<std::string>().value(), baseDir);
-    if (!pathExists(g.file)) fail(key + ".file", show(*f), notFound(g.file));
+    if (mustExist && !pathExists(g.file)) fail(key + ".file", show(*f), notFound(g.file));
   } else if (g.type == "packing") {
     // The grading of a packing file is its own (recorded so in config.resolved.toml).
     if (!s.raw("packing")) fail(key + ".type", show(*type), "\"packing\" is the grading of sample.packing; give sample.packing");
@@ -536,7 +562,14 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
       // Ignoring is intended for the targets of a preparation that does not use them (a config
       // reused with a packing, or with another sample.method): a warning, not an error.
       const bool preparationTarget = key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg";
-      if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget) {
+      // So is a config of one test reused for another with --set test.type=... (a preset's axial
+      // rate when it is run as an isotropic or simple-shear test): the other test's keys warn.
+      static const std::set<std::string> testTypeKeys{
+          "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
+          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed"};
+      const bool otherTestsKey = testTypeKeys.count(key) > 0;
+      if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
+          otherTestsKey) {
         c.warnings.push_back(fmt::format("{} = {} is ignored: {}", key, printable(show(*node)), why));
         continue;
       }
@@ -650,7 +683,7 @@ void setOutputDir(toml::table& table, const std::string& dir) {
   output->as_table()->insert_or_assign("dir", dir);
 }
 
-lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) {
+lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, bool inputFilesMustExist) {
   checkUnknownKeys(root);
   refuseNulCharacters(root, "");
   lab::RunConfig c;
@@ -658,7 +691,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   Section s(root, "sample");
   c.sample.nParticlesGiven = s.raw("n_particles") != nullptr;
   c.sample.nParticles = static_cast<int>(s.integer("n_particles", c.sample.nParticles, 2, 50'000'000));
-  c.sample.grading = parseGrading(s, baseDir);
+  c.sample.grading = parseGrading(s, baseDir, inputFilesMustExist);
   c.sample.density = s.number("density", c.sample.density, 1.0, 1e6, false, false, "must be in [1, 1e6] [kg/m^3]");
   c.sample.e0 = s.number("e0", c.sample.e0, 0.0, 5.0, true, false, "must be > 0 and <= 5 (void ratio)");
   c.sample.seed = static_cast<std::uint64_t>(s.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
@@ -674,7 +707,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
   c.sample.initialVoidRatio = s.number("initial_void_ratio", c.sample.initialVoidRatio, 1.0, 20.0, false, false,
                                        "must be in [1, 20] (loose placement before compaction)");
   c.sample.packing = resolvePath(s.string("packing", c.sample.packing, {}), baseDir);
-  if (!c.sample.packing.empty() && !pathExists(c.sample.packing))
+  if (inputFilesMustExist && !c.sample.packing.empty() && !pathExists(c.sample.packing))
     fail("sample.packing", quotedPath(c.sample.packing), notFound(c.sample.packing));
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
@@ -738,7 +771,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir) 
     const toml::node* file = t.get("file");
     if (!file || !file->is_string()) fail(key + ".file", file ? show(*file) : "(missing)", "a path to a CSV of sphericities is required");
     sc.file = resolvePath(file->value<std::string>().value(), baseDir);
-    if (!pathExists(sc.file)) fail(key + ".file", show(*file), notFound(sc.file));
+    if (inputFilesMustExist && !pathExists(sc.file)) fail(key + ".file", show(*file), notFound(sc.file));
     if (const toml::node* cn = t.get("c")) {
       if (!cn->is_number() || !(numberOf(*cn) > 0.0) || !std::isfinite(numberOf(*cn)) || subnormal(numberOf(*cn)))
         fail(key + ".c", show(*cn), "must be a finite, normal number > 0 (mu_r = c psi^k)");

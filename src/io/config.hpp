@@ -20,7 +20,10 @@ void setOutputDir(toml::table& table, const std::string& dir);
 std::string configBaseDir(const std::string& source);
 // Validates every key (unknown keys, types, ranges) and returns the run description.
 // Throws InputError with a one-line message naming the key, the value and what is allowed.
-lab::RunConfig parseConfig(const toml::table& table, const std::string& baseDir = "");
+// inputFilesMustExist = false: the files a config names (packing, grading list, sphericity file) are
+// not required to exist — for `resume`, which never reads them (the state is in the checkpoint), so
+// a results folder moved away from its inputs still resumes.
+lab::RunConfig parseConfig(const toml::table& table, const std::string& baseDir = "", bool inputFilesMustExist = true);
 // Every key with its value, defaults filled in.
 toml::table resolvedTable(const lab::RunConfig& config);
 std::string toTomlString(const toml::table& table);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <charconv>
 #include <optional>
@@ -48,7 +49,14 @@ std::vector<double> readDiameterList(const std::string& path) {
     const std::optional<double> d = listNumber(field, numeric);
     // The one optional header: the first line that is not blank or a comment, if it has no digit at
     // all (e.g. "diameter_m"); "0.003abc" is a bad diameter, never a header.
-    if (out.empty() && !header && field.find_first_of("0123456789") == std::string_view::npos) {
+    // "nan" and "inf" have no digit but are numbers (refused below as non-finite), not headers.
+    auto isNumberWord = [](std::string_view f) {
+      std::string lower;
+      for (char ch : f)
+        if (ch != '+' && ch != '-') lower += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      return lower == "nan" || lower == "inf" || lower == "infinity";
+    };
+    if (out.empty() && !header && field.find_first_of("0123456789") == std::string_view::npos && !isNumberWord(field)) {
       header = true;
       continue;
     }

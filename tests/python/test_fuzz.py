@@ -265,6 +265,15 @@ class Cases:
             v1[k] = rng.choice(["nan 0.01 0.01 0.01", "0.001 0.01 0.01", "0.001 0.01 0.01 0.01 5",
                                 "-0.001 0.01 0.01 0.01", "0.001 9 0.01 0.01", "0.001 0.01 x 0.01"])
             return "packing v1", {"p.txt": ("\n".join(v1) + "\n").encode()}, self._packing_args(), ["sample.packing"]
+        elif pick < 0.94:  # two grains overlapping deeply or coincident (issue 28: "numerical instability")
+            i, j = rng.sample(range(n), 2) if n > 1 else (0, 0)
+            fi, fj = rows[i].split(), rows[j].split()
+            shift = rng.choice([0.0, 1e-12, 2e-4, 1e-3])  # centre distance; radii 0.002
+            fj[5:8] = [str(float(fi[5]) + shift), fi[6], fi[7]]
+            rows[j] = " ".join(fj)
+            if i == j:
+                rows.append(rows[0].replace("0 sphere", f"{n} sphere", 1))
+                head[5] = f"# particles {n + 1}"
         else:  # a periodic cell under a walls test, or an ellipsoid whose axes are out of order
             if rng.random() < 0.5:
                 head[3] = "# boundary periodic"

@@ -118,10 +118,8 @@ def test_set_paths_relative_to_working_directory(base, tmp_path, grainlab):
     (["sample.method=lattice", "sample.n_particles=125"], ["sample.grading", "lattice"]),
     (["contact.model=rolling-linear", "contact.beta=0.2"], ["contact.beta", "contact.model"]),
     (["contact.model=rolling-linear", "contact.eta=0.5"], ["contact.eta", "contact.model"]),
-    (["test.b=0.5"], ["test.b", "test.type"]),
     (["solver.force_dt=true"], ["solver.force_dt", "solver.dt"]),
     (["sample.growth_rate=1e-5"], ["sample.growth_rate", "sample.method"]),
-    (["test.final_shear_strain=0.3"], ["test.final_shear_strain", "test.type"]),
     (["test.loop_rest=true"], ["test.loop_rest", "test.unload_reload_at"]),
     (["contact.kn=1e5"], ["contact.young", "contact.kn"]),
     (["solver.viscous_damping=100", "solver.damping=0.3"], ["solver.damping", "solver.viscous_damping"]),
@@ -131,6 +129,19 @@ def test_settings_that_cannot_apply(base, sets, words):
         sets = sets + ["contact.young=30e9"]
     line = refused(run("check", str(base), *[a for s in sets for a in ("--set", s)]), *words)
     assert "cannot apply" in line or "lattice" in line
+
+
+@pytest.mark.parametrize("sets,key", [
+    (["test.b=0.5"], "test.b"),
+    (["test.final_shear_strain=0.3"], "test.final_shear_strain"),
+    (['test.type="isotropic"'], "test.axial_strain_rate"),
+])
+def test_keys_of_another_test_type_warn(base, grainlab, sets, key):
+    """A config of one test reused for another (--set test.type=...) keeps the other test's keys:
+    ignored, with a warning that names the key and test.type (issue 28: they were ignored silently)."""
+    proc = grainlab("check", str(base), *[a for s in sets for a in ("--set", s)], check=0)
+    assert f"warning: {key} = " in proc.stderr and "test.type" in proc.stderr and "is ignored" in proc.stderr
+    assert key.split(".")[1] not in tomllib.loads(proc.stdout)["test"]
 
 
 def test_preparation_target_ignored_by_the_method_warns(base, grainlab):

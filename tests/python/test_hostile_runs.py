@@ -301,3 +301,23 @@ def test_checkpoint_copied_from_another_runs_folder_is_refused(tmp_path):
     assert proc.returncode == 2 and "packing.txt" in one_line(proc), proc.stderr
     # b itself resumes.
     assert run(["resume", str(b), "--quiet"]).returncode == 0
+
+
+def test_moved_results_folder_resumes_without_its_input_files(tmp_path):
+    """resume never reads the files a config names (the state is in the checkpoint): a results
+    folder moved away from its grading list (or with the list deleted) still resumes."""
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    (inputs / "grains.csv").write_text("".join(f"{0.004 + 0.002 * (i % 5) / 4:.6f}\n" for i in range(100)))
+    cfg = write(inputs / "c.toml", LONGER.replace(
+        'grading = { type = "uniform", d_min = 4.0e-3, d_max = 6.0e-3 }',
+        'grading = { type = "list", file = "grains.csv" }'))
+    folder = tmp_path / "run"
+    killed_during_shear(cfg, folder)
+    moved = tmp_path / "elsewhere" / "run"
+    moved.parent.mkdir()
+    shutil.move(str(folder), str(moved))
+    shutil.rmtree(inputs)
+    proc = run(["resume", str(moved), "--quiet"])
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads((moved / "summary.json").read_text())["status"] == "completed"
