@@ -1,12 +1,12 @@
 #include "lab/preflight.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cfloat>
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 #include "lab/protocols.hpp"
 
 namespace grainlab::lab {
@@ -74,14 +74,9 @@ void checkTestSteps(const RunConfig& c, const Simulation& sim, double d50) {
 
 }  // namespace
 
-std::uint64_t physicalMemoryBytes() {
-  const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size) : 0;
-}
-
 void preflight(const RunConfig& config, const Simulation* packed) {
   const std::uint64_t n = packed ? packed->particles.size() : static_cast<std::uint64_t>(config.sample.nParticles);
-  const std::uint64_t need = estimatedRunBytes(n), have = physicalMemoryBytes();
+  const std::uint64_t need = estimatedRunBytes(n), have = io::physicalMemoryBytes();
   if (have > 0 && need > have)
     throw InputError(fmt::format("config error: {} = {}: a run of {} particles needs about {:.1f} GiB (~{} bytes per "
                                  "particle), more than this machine's {:.1f} GiB of memory; allowed: at most about {} "

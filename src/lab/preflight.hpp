@@ -19,8 +19,6 @@ namespace grainlab::lab {
 inline constexpr std::uint64_t kBytesPerParticle = 2048;
 // Estimated peak memory of a run of n particles [bytes].
 inline std::uint64_t estimatedRunBytes(std::uint64_t n) { return (64ull << 20) + n * kBytesPerParticle; }
-// The machine's physical memory [bytes] (sysconf), 0 when unknown.
-std::uint64_t physicalMemoryBytes();
 
 // Every check above; `packed` is the packing of sample.packing (nullptr: the sample is prepared).
 void preflight(const RunConfig& config, const Simulation* packed);
