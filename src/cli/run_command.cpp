@@ -119,6 +119,16 @@ lab::RunConfig resolveConfig(const RunOptions& opt, bool inputFilesMustExist = t
 }  // namespace
 
 namespace {
+// A packing brings its own particles, whatever sample.n_particles says: a count that differs is
+// ignored with this warning (a config that prepared a sample is meant to be reused with
+// --set sample.packing=...; config.resolved.toml records the packing's count).
+std::string packingCountWarning(const lab::RunConfig& config, std::size_t particles) {
+  if (!config.sample.nParticlesGiven || static_cast<std::size_t>(config.sample.nParticles) == particles) return "";
+  return fmt::format("sample.n_particles = {} is ignored: sample.packing = {} holds {} particles (a packing brings its "
+                     "own)",
+                     config.sample.nParticles, io::quotedPath(config.sample.packing), particles);
+}
+
 // The config's warnings, printed once everything it names has been read and checked: a refused
 // input says one line, its error, and nothing else.
 void printConfigWarnings(const lab::RunConfig& config) {
@@ -148,11 +158,7 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   }
   const io::PackingData packing = io::readPackingFile(config.sample.packing, "sample.packing");
   io::checkPackingGeometry(packing, fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
-  if (config.sample.nParticlesGiven && static_cast<std::size_t>(config.sample.nParticles) != packing.particles.size())
-    throw InputError(fmt::format("config error: sample.n_particles = {}: sample.packing = {} holds {} particles; allowed: "
-                                 "no sample.n_particles, or {}",
-                                 config.sample.nParticles, io::quotedPath(config.sample.packing),
-                                 packing.particles.size(), packing.particles.size()));
+
   Simulation packed;
   io::simulationFromPacking(packing, config.sample.density, packed,
                             fmt::format("config error: sample.packing = {}", io::quotedPath(config.sample.packing)));
@@ -165,12 +171,15 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
                                  config.test.boundary));
   lab::preflight(config, &packed);
   printConfigWarnings(config);
+  if (const std::string w = packingCountWarning(config, packed.particles.size()); !w.empty())
+    std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
   return packed;
 }
 
 lab::RunConfig ranConfig(const lab::RunConfig& config, const std::optional<Simulation>& packed) {
   lab::RunConfig ran = config;
   if (packed) {
+    if (const std::string w = packingCountWarning(config, packed->particles.size()); !w.empty()) ran.warnings.push_back(w);
     ran.sample.nParticles = static_cast<int>(packed->particles.size());
     ran.sample.nParticlesGiven = true;
     ran.sample.grading = lab::GradingConfig{.type = "packing", .diameters = {}, .passing = {}};

@@ -40,7 +40,9 @@ void writeValue(std::ostream& os, const toml::node& node) {
     }
     os << "]";
   } else if (const auto* d = node.as_floating_point()) {
-    os << fmt::format("{}", d->get());
+    std::string text = fmt::format("{}", d->get());  // shortest exact form; 1.0 stays a float: "1.0"
+    if (text.find_first_of(".eEni") == std::string::npos) text += ".0";
+    os << text;
   } else {
     node.visit([&](const auto& v) { os << v; });
   }

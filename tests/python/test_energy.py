@@ -28,7 +28,15 @@ def terms(row):
 @pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
 def test_energy_balance_closes_within_one_percent(grainlab, data_dir, tmp_path, case):
     out = tmp_path / case
-    grainlab("run", os.path.join(data_dir, "small-triaxial.toml"), "--out", str(out), "--threads", "1", "--quiet",
+    config = os.path.join(data_dir, "small-triaxial.toml")
+    if "rolling-linear" in case:
+        # The Kozicki keys (beta, eta) cannot apply to the rolling-linear law: a config without them.
+        with open(config) as f:
+            lines = [l for l in f if not l.strip().startswith(("beta", "eta"))]
+        config = str(tmp_path / "rolling-linear.toml")
+        with open(config, "w") as f:
+            f.writelines(lines)
+    grainlab("run", config, "--out", str(out), "--threads", "1", "--quiet",
              "--set", "output.vtk_every_strain=0", *CASES[case], check=0)
     with open(out / "timeseries.csv", newline="") as f:
         rows = list(csv.DictReader(f))

@@ -80,8 +80,10 @@ def test_resolved_config_records_the_packing(base, tmp_path, grainlab):
     assert "e0" not in resolved["sample"] and "method" not in resolved["sample"]
     # The resolved config is itself a valid config.
     grainlab("check", str(out / "config.resolved.toml"), "--set", f"output.dir={tmp_path / 'third'}", check=0)
-    # A count that contradicts the packing is refused.
-    refused(run("check", str(cfg), "--set", "sample.n_particles=99"), "sample.n_particles = 99", "holds 100")
+    # A count that contradicts the packing is ignored with a warning (the packing brings its own).
+    proc = grainlab("check", str(cfg), "--set", "sample.n_particles=99", check=0)
+    assert "warning: sample.n_particles = 99 is ignored" in proc.stderr and "holds 100" in proc.stderr
+    assert tomllib.loads(proc.stdout)["sample"]["n_particles"] == 100
     # Preparation keys beside a packing (a config reused with --set sample.packing=...) are ignored
     # with a warning, and not recorded.
     proc = grainlab("check", str(cfg), "--set", "sample.e0=0.7", "--set", f"output.dir={out}", check=0)
