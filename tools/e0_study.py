@@ -21,7 +21,7 @@ import math
 import os
 import sys
 
-from study_runs import completed, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
+from study_runs import completed, residual_state, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -120,7 +120,7 @@ def report(args):
         fig.savefig(os.path.join(figdir, png), dpi=90)
         plt.close(fig)
     lines = ["| case | seed | e0 | Z | Z_mech | house of cards | E0 [MPa] | ν0 | E50 [MPa] | φp [°] | φres [°] | "
-             "φp − φres [°] | ψmax [°] | εv at 20 % [%] | q/p end | e end | σ3 dev. max [%] | wall [s] |",
+             "φp − φres [°] | ψmax [°] | εv at 20 % [%] | q/p res | e res | σ3 dev. max [%] | wall [s] |",
              "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for case, label, seed, _, sm, s in found:
         lines.append(
@@ -128,7 +128,7 @@ def report(args):
             f"{'yes' if sm.get('house_of_cards') else 'no'} | {fmt(sm.get('E0_MPa'), '.0f')} | {fmt(sm.get('nu0'), '.3f')} | "
             f"{fmt(sm.get('E50_MPa'), '.0f')} | {sm['phi_peak_deg']:.1f} | {sm['phi_res_deg']:.1f} | "
             f"{sm['phi_peak_deg'] - sm['phi_res_deg']:.1f} | {fmt(sm.get('psi_max_deg'), '.1f')} | "
-            f"{100 * s['eps_v'][-1]:.2f} | {sm['cs_q_over_p']:.2f} | {sm['cs_void_ratio']:.3f} | "
+            f"{100 * s['eps_v'][-1]:.2f} | {residual_state(sm)[0]:.2f} | {residual_state(sm)[1]:.3f} | "
             f"{100 * sm['lateral_stress_max_deviation']:.1f} | {sm['wall_seconds']:.0f} |")
     # The targets of issue 13, checked per pair of seeds.
     lines += ["", "| target | result |", "|---|---|"]
@@ -147,8 +147,8 @@ def report(args):
             lines.append(f"| {tag}: no peak (φp − φres < 2°) | {d:.1f}° → {'met' if d < 2 else 'missed'} |")
             if "dense" in pair:
                 b_ = pair["dense"][0]
-                dq = abs(sm["cs_q_over_p"] - b_["cs_q_over_p"])
-                de = abs(sm["cs_void_ratio"] - b_["cs_void_ratio"])
+                dq = abs(residual_state(sm)[0] - residual_state(b_)[0])
+                de = abs(residual_state(sm)[1] - residual_state(b_)[1])
                 lines.append(f"| {tag} vs dense: same end state, q/p within 0.1 | {dq:.3f} → {'met' if dq <= 0.1 else 'missed'} |")
                 lines.append(f"| {tag} vs dense: same end state, e within 0.03 | {de:.3f} → {'met' if de <= 0.03 else 'missed'} |")
     path = os.path.join(args.docs, f"{name}-table.md")

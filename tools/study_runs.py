@@ -22,6 +22,16 @@ def summary(folder):
         return json.load(f)
 
 
+def residual_state(summary):
+    """(q/p, e) over the residual window (the last 20 % of the test, phi_res's window): the summary's
+    residual_q_over_p, residual_void_ratio, or, for a summary written before the critical-state
+    criterion existed, the same means it called cs_*. Not a critical state unless
+    summary["critical_state_reached"] says so."""
+    if "residual_q_over_p" in summary:
+        return summary["residual_q_over_p"], summary["residual_void_ratio"]
+    return summary.get("cs_q_over_p"), summary.get("cs_void_ratio")
+
+
 def write_table(path, lines, header=""):
     """Writes the table's lines (after an optional header line) to path and prints them."""
     with open(path, "w") as f:

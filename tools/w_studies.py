@@ -29,6 +29,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_runs import residual_state  # noqa: E402 (tools/, beside this script)
+
 # (study, key, values, base value, label, how a value is printed)
 BASE = {"contact.beta": 0.15, "contact.eta": 1.0, "contact.friction_deg": 30.0,
         "contact.young": 30e9, "test.confining_pressure": 100e3, "sample.e0": 0.60}
@@ -161,7 +164,7 @@ def report(opt):
     plots = os.path.join(opt.docs, "w-studies")
     os.makedirs(plots, exist_ok=True)
     lines = ["| study | value | e0 reached | φp [°] | ε1 at peak [%] | φres [°] | ψmax [°] | E [MPa] | "
-             "E50 [MPa] | ν | q/p cs | e cs | I max | σ3 dev. max [%] | wall [s] |",
+             "E50 [MPa] | ν | q/p res | e res | I max | σ3 dev. max [%] | wall [s] |",
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     total_wall = 0.0
     seen = set()
@@ -180,7 +183,7 @@ def report(opt):
                 f"| {study} | {name} | {summary['e0']:.3f} | {summary['phi_peak_deg']:.1f} | "
                 f"{100 * summary['eps1_at_peak']:.2f} | {summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | "
                 f"{summary['E_MPa']:.0f} | {summary['E50_MPa']:.0f} | {summary['nu']:.2f} | "
-                f"{summary['cs_q_over_p']:.2f} | {summary['cs_void_ratio']:.3f} | "
+                f"{residual_state(summary)[0]:.2f} | {residual_state(summary)[1]:.3f} | "
                 f"{summary['inertial_number_max']:.2e} | {100 * summary['lateral_stress_max_deviation']:.1f} | "
                 f"{summary['wall_seconds']:.0f} |")
             eps1 = [100 * float(r["eps1"]) for r in series]
@@ -196,7 +199,7 @@ def report(opt):
 
 def size(opt):
     sizes = [int(n) for n in opt.sizes.split(",")]
-    rows = ["| spheres | e0 reached | φp [°] | ε1 at peak [%] | φres [°] | ψmax [°] | E [MPa] | q/p cs | e cs | "
+    rows = ["| spheres | e0 reached | φp [°] | ε1 at peak [%] | φres [°] | ψmax [°] | E [MPa] | q/p res | e res | "
             "σ3 dev. max [%] | rotation in / outside band [°] | wall [s] |",
             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     figs = {c: plt.subplots(figsize=(7, 4.5)) for c in ("q", "eps_v")}
@@ -211,7 +214,7 @@ def size(opt):
             continue
         rows.append(f"| {n} | {summary['e0']:.3f} | {summary['phi_peak_deg']:.1f} | {100 * summary['eps1_at_peak']:.2f} | "
                     f"{summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | {summary['E_MPa']:.0f} | "
-                    f"{summary['cs_q_over_p']:.2f} | {summary['cs_void_ratio']:.3f} | "
+                    f"{residual_state(summary)[0]:.2f} | {residual_state(summary)[1]:.3f} | "
                     f"{100 * summary['lateral_stress_max_deviation']:.1f} | "
                     f"{summary['rotation_band_mean_deg']:.1f} / {summary['rotation_outside_band_mean_deg']:.1f} | "
                     f"{summary['wall_seconds']:.0f} |")

@@ -66,7 +66,7 @@ def report(a):
         lines.append(
             f"| {label} | {s['e0']:.3f} | {s['Z']:.2f} | {fmt(s.get('Z_mech'), 2)} | {fmt(s.get('phi_peak_deg'))} | "
             f"{fmt(100 * s['eps1_at_peak'] if s.get('eps1_at_peak') is not None else None)} | "
-            f"{fmt(s.get('psi_max_deg'))} | {fmt(s.get('phi_res_deg'))} | {fmt(s.get('cs_void_ratio'), 3)} | "
+            f"{fmt(s.get('psi_max_deg'))} | {fmt(s.get('phi_res_deg'))} | {fmt(s.get('residual_void_ratio', s.get('cs_void_ratio')), 3)} | "
             f"{fmt(s.get('E50_MPa'), 0)} | {fmt(s.get('rotation_mean_deg'))} | "
             f"{fmt(100 * dev if dev is not None else None)} | {s['wall_seconds']:.0f} |")
         style = "-" if "spheroid" in case else "--"

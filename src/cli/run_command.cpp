@@ -321,6 +321,7 @@ class RunSession {
     summary_["phi_res_deg"] = finite(m.phiResDeg, "phi_res_deg");
     summary_["residual_window_eps1"] = {m.residualFrom, records.back().eps1};
     summary_["psi_max_deg"] = m.psiMaxDeg ? json(finite(*m.psiMaxDeg, "psi_max_deg")) : json(nullptr);
+    summary_["psi_max_tan_deg"] = m.psiMaxTanDeg ? json(finite(*m.psiMaxTanDeg, "psi_max_tan_deg")) : json(nullptr);
     summary_["eps1_at_psi_max"] = m.eps1AtPsiMax;
     if (simpleShear) {
       // Simple shear measures a shear modulus; Young's modulus and Poisson's ratio are not measured.
@@ -335,8 +336,30 @@ class RunSession {
                                      : "not measured (q never reached half its peak above its start)";
     }
     moduliFromLoops(lab::unloadReloadLoops(loopEps1, loopQ, loopPhase));
-    summary_["cs_q_over_p"] = m.csStressRatio;
-    summary_["cs_void_ratio"] = m.csVoidRatio;
+    // The critical state only where the steady-state criterion (lab/macro.hpp) was met; the end of
+    // the test always, with its rates, so that a sample still dilating says so.
+    const lab::SteadyState& cs = m.steady;
+    const lab::MacroSettings criterion;
+    summary_["residual_q_over_p"] = m.residualStressRatio;
+    summary_["residual_void_ratio"] = m.residualVoidRatio;
+    summary_["critical_state_reached"] = cs.reached;
+    summary_["critical_state_eps1"] = cs.reached ? json(cs.reachedAt) : json(nullptr);
+    summary_["cs_q_over_p"] = cs.reached ? json(finite(cs.stressRatio, "cs_q_over_p")) : json(nullptr);
+    summary_["cs_void_ratio"] = cs.reached ? json(finite(cs.voidRatio, "cs_void_ratio")) : json(nullptr);
+    summary_["cs_p"] = cs.reached ? json(finite(cs.meanStress, "cs_p")) : json(nullptr);
+    summary_["end_q_over_p"] = cs.evaluated ? json(finite(cs.endStressRatio, "end_q_over_p")) : json(nullptr);
+    summary_["end_void_ratio"] = cs.evaluated ? json(finite(cs.endVoidRatio, "end_void_ratio")) : json(nullptr);
+    summary_["end_p"] = cs.evaluated ? json(finite(cs.endMeanStress, "end_p")) : json(nullptr);
+    summary_["end_rates"] = cs.evaluated ? json{{"d_q_over_p", cs.endStressRatioRate},
+                                                {"d_eps_v", cs.endVolumetricRate},
+                                                {"d_e", cs.endVoidRatioRate}}
+                                         : json(nullptr);
+    summary_["critical_state_criterion"] = fmt::format(
+        "every trailing window of {} {} from critical_state_eps1 to the end has |d(q/p)/d eps| <= {}, |d eps_v/d eps| "
+        "<= {} and |d e/d eps| <= {} (least-squares slopes, >= {} records); cs_* are the means from "
+        "critical_state_eps1 to the end, end_* those of the last window",
+        criterion.csWindow, simpleShear ? "shear strain" : "axial strain", criterion.csMaxStressRatioRate,
+        criterion.csMaxVolumetricRate, criterion.csMaxVoidRatioRate, criterion.csMinRecords);
     summary_["strain_rate"] = shear.strainRate;
     summary_["inertial_number"] = shear.inertialNumber;
     summary_["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
@@ -448,6 +471,19 @@ class RunSession {
                     summary_["phi_res_deg"].get<double>(), shown(summary_["psi_max_deg"], "%.2f").c_str(),
                     shown(summary_["E0_MPa"], "%.1f").c_str(), shown(summary_["nu0"], "%.3f").c_str(),
                     shown(summary_["E50_MPa"], "%.1f").c_str());
+      if (summary_.contains("critical_state_reached")) {
+        if (summary_["critical_state_reached"].get<bool>())
+          std::printf("critical state reached at %s = %.4f: q/p = %.3f, e = %.4f\n",
+                      summary_.contains("G_MPa") ? "gamma" : "eps1", summary_["critical_state_eps1"].get<double>(),
+                      summary_["cs_q_over_p"].get<double>(), summary_["cs_void_ratio"].get<double>());
+        else if (summary_["end_rates"].is_object())
+          std::printf("critical state not reached: at the end d eps_v/d eps = %.3f, d(q/p)/d eps = %.2f (q/p = %.3f, e = "
+                      "%.4f)\n",
+                      summary_["end_rates"]["d_eps_v"].get<double>(), summary_["end_rates"]["d_q_over_p"].get<double>(),
+                      summary_["end_q_over_p"].get<double>(), summary_["end_void_ratio"].get<double>());
+        else
+          std::printf("critical state not reached: the test is shorter than the criterion's window\n");
+      }
       std::printf("%ld steps in %.1f s; results in %s\n", steps, wall, io::printable(target_.native(), 240).c_str());
     }
     return 0;

@@ -413,7 +413,7 @@ int runSweep(const SweepOptions& opt) {
   static const std::vector<std::string> columns{
       "e0", "phi_peak_deg", "eps1_at_peak", "phi_res_deg", "psi_max_deg", "E_MPa", "E50_MPa", "nu",
       "cs_q_over_p", "cs_void_ratio", "inertial_number", "inertial_number_max", "lateral_stress_max_deviation",
-      "steps", "wall_seconds"};
+      "steps", "wall_seconds", "psi_max_tan_deg", "critical_state_reached", "end_q_over_p", "end_void_ratio"};
   std::string csv = "case,status";
   for (const auto& v : varies) csv += "," + csvField(v.key);
   for (const auto& c : columns) csv += "," + c;
@@ -459,6 +459,7 @@ int runSweep(const SweepOptions& opt) {
     for (const auto& c : columns) {
       csv += ",";
       if (ok && summary.contains(c) && summary[c].is_number()) csv += fmt::format("{:.8g}", summary[c].get<double>());
+      if (ok && summary.contains(c) && summary[c].is_boolean()) csv += summary[c].get<bool>() ? "true" : "false";
     }
     // attempts 0: the case was completed by an earlier session of the sweep, or not run.
     if (!dask.empty()) csv += fmt::format(",{},{}", dask[i].attempts, csvField(dask[i].workers));

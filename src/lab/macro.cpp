@@ -19,6 +19,8 @@ double dilatancyAngleDeg(double r) {
   return radToDeg(std::asin(std::clamp(-r / (2.0 - r), -1.0, 1.0)));
 }
 
+double dilatancyAngleTanDeg(double r) { return radToDeg(std::atan(-r)); }
+
 double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t b, std::size_t e) {
   const double n = static_cast<double>(e - b);
   if (e <= b + 1) return 0.0;
@@ -35,6 +37,61 @@ double slope(const std::vector<double>& x, const std::vector<double>& y, std::si
     sxx += (x[i] - mx) * (x[i] - mx);
   }
   return sxx > 0.0 ? sxy / sxx : 0.0;
+}
+
+SteadyState steadyState(const std::vector<double>& eps, const std::vector<double>& eta,
+                        const std::vector<double>& epsV, const std::vector<double>& e,
+                        const std::vector<double>& p, const MacroSettings& s) {
+  SteadyState out;
+  const std::size_t n = eps.size();
+  if (eta.size() != n || epsV.size() != n || e.size() != n || p.size() != n) return out;
+  if (n < s.csMinRecords || eps.back() - eps.front() < s.csWindow) return out;
+  auto mean = [](const std::vector<double>& v, std::size_t b, std::size_t end) {
+    double sum = 0.0;
+    for (std::size_t i = b; i < end; ++i) sum += v[i];
+    return end > b ? sum / static_cast<double>(end - b) : 0.0;
+  };
+  // Windows ending at record k: [first record with eps >= eps_k - window, k].
+  std::vector<char> steady(n, 0), evaluated(n, 0);
+  std::size_t lo = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (eps[k] - eps.front() < s.csWindow) continue;
+    while (lo < k && eps[lo] < eps[k] - s.csWindow) ++lo;
+    const std::size_t b = lo, end = k + 1;
+    if (end - b < s.csMinRecords) continue;
+    evaluated[k] = 1;
+    const double rEta = slope(eps, eta, b, end), rV = slope(eps, epsV, b, end), rE = slope(eps, e, b, end);
+    steady[k] = std::abs(rEta) <= s.csMaxStressRatioRate && std::abs(rV) <= s.csMaxVolumetricRate &&
+                std::abs(rE) <= s.csMaxVoidRatioRate;
+    if (k + 1 == n) {
+      out.evaluated = true;
+      out.endStressRatio = mean(eta, b, end);
+      out.endVoidRatio = mean(e, b, end);
+      out.endMeanStress = mean(p, b, end);
+      out.endStressRatioRate = rEta;
+      out.endVolumetricRate = rV;
+      out.endVoidRatioRate = rE;
+    }
+  }
+  if (!out.evaluated || !steady[n - 1]) return out;
+  // The steady run to the end: back from the last record while every evaluated window is steady.
+  std::size_t first = n - 1;
+  while (first > 0 && evaluated[first - 1] && steady[first - 1]) --first;
+  out.reached = true;
+  out.reachedAt = eps[first];
+  // The critical-state values: the means from eps* to the end (every window ending there is steady),
+  // or of the last window when fewer than csMinRecords records follow eps*.
+  std::size_t b = first;
+  if (n - b < s.csMinRecords) {
+    out.stressRatio = out.endStressRatio;
+    out.voidRatio = out.endVoidRatio;
+    out.meanStress = out.endMeanStress;
+    return out;
+  }
+  out.stressRatio = mean(eta, b, n);
+  out.voidRatio = mean(e, b, n);
+  out.meanStress = mean(p, b, n);
+  return out;
 }
 
 namespace {
@@ -54,8 +111,8 @@ void residualMeans(const TriaxialCurves& c, const std::vector<double>& phi, cons
   }
   if (count > 0) {
     m.phiResDeg = sumPhi / count;
-    m.csStressRatio = sumRatio / count;
-    m.csVoidRatio = sumE / count;
+    m.residualStressRatio = sumRatio / count;
+    m.residualVoidRatio = sumE / count;
   }
 }
 
@@ -109,7 +166,15 @@ MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
                  return dilatancyAngleDeg(rate);
                },
                m);
+  {
+    // The same windows in the other convention, tan psi = D (defined for any rate).
+    MacroParameters t;
+    maxDilatancy(c, s.dilatancyHalfWindow,
+                 [](double rate) -> std::optional<double> { return dilatancyAngleTanDeg(rate); }, t);
+    m.psiMaxTanDeg = t.psiMaxDeg;
+  }
   m.e50 = secantE50(c.eps1, q);
+  m.steady = steadyState(c.eps1, ratio, c.epsV, c.voidRatio, p, s);
   return m;
 }
 
@@ -130,7 +195,9 @@ MacroParameters computeSimpleShearMacro(const TriaxialCurves& c, const MacroSett
   residualMeans(c, phi, ratio, m);
   // Simple shear: tan psi = -d eps_v / d gamma.
   maxDilatancy(c, s.dilatancyHalfWindow,
-               [](double rate) -> std::optional<double> { return radToDeg(std::atan(-rate)); }, m);
+               [](double rate) -> std::optional<double> { return dilatancyAngleTanDeg(rate); }, m);
+  m.psiMaxTanDeg = m.psiMaxDeg;  // simple shear's psi is the tan definition already
+  m.steady = steadyState(c.eps1, ratio, c.epsV, c.voidRatio, c.sigma1, s);
   std::size_t end = 0;
   while (end < n && c.eps1[end] <= s.elasticWindow) ++end;
   end = std::max<std::size_t>(end, std::min<std::size_t>(n, 3));

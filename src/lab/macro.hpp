@@ -24,11 +24,39 @@ struct TriaxialCurves {
 //    a dedicated probe (Laboratory::probeModuli), not from these curves;
 //  - simple shear's G: least-squares slope of tau on gamma over gamma <= elasticWindow (0.1 %), at
 //    least the first 3 records.
+//  - critical (steady) state: over trailing windows of csWindow of the test's strain (eps1, or gamma
+//    in simple shear), the least-squares slopes of the stress ratio eta = q/p (tau/sigma_n), of
+//    eps_v and of e against the strain must all be small: |d eta/d eps| <= csMaxStressRatioRate,
+//    |d eps_v/d eps| <= csMaxVolumetricRate, |d e/d eps| <= csMaxVoidRatioRate, in every window
+//    that ends from some strain eps* to the end of the test (at least csMinRecords records each).
+//    eps* is where the critical state was reached; its values are the means from eps* to the end
+//    (those of the last window when fewer than csMinRecords records follow eps*). A test that does not meet it has no critical state, only its end values (the means
+//    over the last window, and the slopes there).
 struct MacroSettings {
   double residualFraction = 0.2;
   double dilatancyHalfWindow = 0.005;
   double elasticWindow = 0.001;
+  double csWindow = 0.05;
+  double csMaxStressRatioRate = 0.5;
+  double csMaxVolumetricRate = 0.02;
+  double csMaxVoidRatioRate = 0.05;
+  std::size_t csMinRecords = 5;
 };
+
+// The steady-state check of MacroSettings over the curves' strain `eps`: means and slopes of the
+// last window, and whether (and from where) every trailing window meets the thresholds.
+struct SteadyState {
+  bool evaluated = false;          // the test reached at least one window of csMinRecords records
+  bool reached = false;
+  double reachedAt = 0.0;          // eps* (end of the first window of the steady run to the end)
+  double stressRatio = 0.0, voidRatio = 0.0, meanStress = 0.0;  // means from eps* to the end
+  // The last window: its means and the slopes of eta, eps_v and e against the strain.
+  double endStressRatio = 0.0, endVoidRatio = 0.0, endMeanStress = 0.0;
+  double endStressRatioRate = 0.0, endVolumetricRate = 0.0, endVoidRatioRate = 0.0;
+};
+SteadyState steadyState(const std::vector<double>& eps, const std::vector<double>& stressRatio,
+                        const std::vector<double>& epsV, const std::vector<double>& voidRatio,
+                        const std::vector<double>& meanStress, const MacroSettings& s = {});
 
 struct MacroParameters {
   double phiPeakDeg = 0.0;
@@ -39,15 +67,25 @@ struct MacroParameters {
   std::optional<double> psiMaxDeg;  // null when no window could be evaluated
   double eps1AtPsiMax = 0.0;
   std::optional<double> e50;        // [Pa]; null when not measurable (lab/moduli.hpp)
-  double csStressRatio = 0.0;  // q/p over the residual window (simple shear: tau/sigma_n)
-  double csVoidRatio = 0.0;
+  // Means over the residual window (phi_res's): q/p (simple shear: tau/sigma_n) and e. Not a
+  // critical state unless `steady` says one was reached.
+  double residualStressRatio = 0.0;
+  double residualVoidRatio = 0.0;
+  // tan psi = D = -d eps_v/d eps1 (simple shear: -d eps_v/d gamma), the other convention's largest
+  // angle over the same windows; psiMaxDeg is sin psi = D/(2 + D) for the axial tests.
+  std::optional<double> psiMaxTanDeg;
+  SteadyState steady;         // the critical-state criterion of MacroSettings
   double shearModulus = 0.0;  // simple shear: least-squares slope of tau on gamma in the elastic window [Pa]
 };
 
 // phi = asin((sigma1 - sigma3)/(sigma1 + sigma3)) [deg]
 double mobilisedFrictionDeg(double sigma1, double sigma3);
-// psi = asin(-r/(2 - r)) with r = d(eps_v)/d(eps1) [deg]; positive in dilation.
+// psi = asin(-r/(2 - r)) with r = d(eps_v)/d(eps1) [deg]; positive in dilation. With D = -r the
+// dilatancy rate: sin psi = D/(2 + D), the triaxial definition (principal strain rates of a
+// cylinder: d eps_v = d eps1 + 2 d eps3).
 double dilatancyAngleDeg(double rate);
+// The plane-strain / direct-shear definition tan psi = D = -r [deg].
+double dilatancyAngleTanDeg(double rate);
 // Least-squares slope of y on x over indices [begin, end).
 double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t begin, std::size_t end);
 

@@ -22,7 +22,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SEEDS = (7, 8, 9, 10, 11)
 CASES = {"kozicki-eta0.1": ["contact.eta=0.1"], "no-moments": ["contact.beta=0"]}
 FLOORS = {"e0": 0.01, "phi_peak_deg": 1.0, "phi_res_deg": 1.0, "psi_max_deg": 2.0, "E0_MPa": 100.0,
-          "cs_void_ratio": 0.02}
+          "residual_void_ratio": 0.02}
 
 
 def run(exe, sets, seed, out):

@@ -49,8 +49,8 @@ TEST(Macro, KnownAnswersFromSyntheticCurves) {
   EXPECT_LT(m.eps1AtPsiMax, 0.095);
   // Critical state: q/p = 6 sin phi / (3 - sin phi) for triaxial compression.
   const double s = std::sin(degToRad(32.0));
-  EXPECT_NEAR(m.csStressRatio, 6 * s / (3 - s), 1e-9);
-  EXPECT_NEAR(m.csVoidRatio, 0.6 - 1.6 * (0.0025 - 0.045), 1e-9);
+  EXPECT_NEAR(m.residualStressRatio, 6 * s / (3 - s), 1e-9);
+  EXPECT_NEAR(m.residualVoidRatio, 0.6 - 1.6 * (0.0025 - 0.045), 1e-9);
   // E50: secant to half the peak q. q_peak = s3 * 2 s/(1 - s) at 40 deg; half of it is reached where
   // 2 s/(1 - s) = q_peak/(2 s3), i.e. s = x/(2 + x), phi = asin(s), eps1 = 0.02 phi/40 deg.
   const double sp = std::sin(degToRad(40.0));
@@ -59,4 +59,99 @@ TEST(Macro, KnownAnswersFromSyntheticCurves) {
   const double eps50 = 0.02 * radToDeg(std::asin(x / (2 + x))) / 40.0;
   ASSERT_TRUE(m.e50.has_value());
   EXPECT_NEAR(*m.e50 / (half / eps50), 1.0, 0.005);
+}
+
+// --- the critical-state criterion (lab::steadyState) and the two dilatancy conventions ------------
+
+TEST(Macro, DilatancyAngleInBothConventionsAgainstHandNumbers) {
+  // D = -d eps_v/d eps1 = 0.5: sin psi = D/(2 + D) = 0.2 -> 11.537 deg; tan psi = D -> 26.565 deg.
+  EXPECT_NEAR(lab::dilatancyAngleDeg(-0.5), 11.536959032815489, 1e-9);
+  EXPECT_NEAR(lab::dilatancyAngleTanDeg(-0.5), 26.565051177077990, 1e-9);
+  EXPECT_NEAR(lab::dilatancyAngleTanDeg(0.25), -14.036243467926479, 1e-9);  // contraction: negative
+  const lab::MacroParameters m = lab::computeMacro(syntheticCurves());
+  ASSERT_TRUE(m.psiMaxTanDeg.has_value());
+  EXPECT_NEAR(*m.psiMaxTanDeg, 26.565051177077990, 1e-6);  // the dilating branch's slope -0.5
+}
+
+TEST(Macro, CriticalStateReachedOnlyWhereStressRatioAndVolumeAreSteady) {
+  // phi constant from 8 %, eps_v from 10 %: every 5 % window is steady once it starts after
+  // 10 % (a window reaching back into the -0.5 branch has a volumetric slope above 0.02 as soon as
+  // it holds more than ~2 records of it), so eps* is just below 15 %.
+  const lab::MacroParameters m = lab::computeMacro(syntheticCurves());
+  const lab::SteadyState& cs = m.steady;
+  ASSERT_TRUE(cs.evaluated);
+  ASSERT_TRUE(cs.reached);
+  EXPECT_GT(cs.reachedAt, 0.14);
+  EXPECT_LE(cs.reachedAt, 0.15 + 1e-12);
+  const double s = std::sin(degToRad(32.0));
+  EXPECT_NEAR(cs.stressRatio, 6 * s / (3 - s), 1e-9);
+  EXPECT_NEAR(cs.voidRatio, 0.6 - 1.6 * (0.0025 - 0.045), 1e-9);
+  EXPECT_NEAR(cs.meanStress, 100e3 * (1 + 2 * s / (1 - s) / 3), 1e-3);  // p = s3 + q/3
+  EXPECT_NEAR(cs.endVolumetricRate, 0.0, 1e-12);
+}
+
+TEST(Macro, ASampleStillDilatingHasNoCriticalState) {
+  // A dense sample at 20 %: phi already constant, but eps_v still falling at -0.3 to the end.
+  lab::TriaxialCurves c = syntheticCurves();
+  for (std::size_t i = 0; i < c.eps1.size(); ++i) {
+    const double e = c.eps1[i];
+    if (e > 0.10) {
+      c.epsV[i] = 0.0025 - 0.045 - 0.3 * (e - 0.10);
+      c.voidRatio[i] = 0.6 - 1.6 * c.epsV[i];
+    }
+  }
+  const lab::SteadyState cs = lab::computeMacro(c).steady;
+  ASSERT_TRUE(cs.evaluated);
+  EXPECT_FALSE(cs.reached);
+  EXPECT_NEAR(cs.endVolumetricRate, -0.3, 1e-9);
+  EXPECT_NEAR(cs.endVoidRatioRate, 0.48, 1e-9);  // de = -(1 + e0) d eps_v
+  EXPECT_NEAR(cs.endStressRatioRate, 0.0, 1e-9);
+}
+
+TEST(Macro, AStressRatioStillFallingHasNoCriticalState) {
+  // Volume steady, but q/p softening at 1 per unit strain (above the 0.5 threshold) to the end.
+  std::vector<double> eps, eta, ev, e, p;
+  for (int i = 0; i <= 400; ++i) {
+    eps.push_back(5e-4 * i);
+    eta.push_back(1.4 - 1.0 * eps.back());
+    ev.push_back(-0.03);
+    e.push_back(0.65);
+    p.push_back(100e3);
+  }
+  lab::SteadyState cs = lab::steadyState(eps, eta, ev, e, p);
+  ASSERT_TRUE(cs.evaluated);
+  EXPECT_FALSE(cs.reached);
+  EXPECT_NEAR(cs.endStressRatioRate, -1.0, 1e-9);
+  // The same curve softening at 0.4 per unit strain is within the criterion.
+  for (std::size_t i = 0; i < eps.size(); ++i) eta[i] = 1.4 - 0.4 * eps[i];
+  cs = lab::steadyState(eps, eta, ev, e, p);
+  EXPECT_TRUE(cs.reached);
+  EXPECT_NEAR(cs.reachedAt, 0.05, 1e-12);  // from the first full window on
+}
+
+TEST(Macro, NoisySteadyCurvesReachItAndShortTestsAreNotEvaluated) {
+  // Flat curves with record-to-record noise (+-0.01 in q/p, +-1e-4 in eps_v), as DEM gives.
+  std::vector<double> eps, eta, ev, e, p;
+  std::uint32_t state = 12345;
+  auto noise = [&] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<double>(state >> 8) / static_cast<double>(1u << 24) - 0.5;
+  };
+  for (int i = 0; i <= 300; ++i) {
+    eps.push_back(1e-3 * i);
+    eta.push_back(1.2 + 0.02 * noise());
+    ev.push_back(-0.05 + 2e-4 * noise());
+    e.push_back(0.68 - 1.6 * (ev.back() + 0.05));
+    p.push_back(100e3 * (1 + 0.01 * noise()));
+  }
+  const lab::SteadyState cs = lab::steadyState(eps, eta, ev, e, p);
+  EXPECT_TRUE(cs.reached);
+  EXPECT_NEAR(cs.stressRatio, 1.2, 0.005);
+  // A test shorter than one window: not evaluated, no critical state and no end values.
+  const std::vector<double> shortEps(eps.begin(), eps.begin() + 40);
+  const std::vector<double> shortEta(eta.begin(), eta.begin() + 40), shortEv(ev.begin(), ev.begin() + 40),
+      shortE(e.begin(), e.begin() + 40), shortP(p.begin(), p.begin() + 40);
+  const lab::SteadyState none = lab::steadyState(shortEps, shortEta, shortEv, shortE, shortP);
+  EXPECT_FALSE(none.evaluated);
+  EXPECT_FALSE(none.reached);
 }
