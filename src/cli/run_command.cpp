@@ -182,7 +182,7 @@ lab::RunConfig ranConfig(const lab::RunConfig& config, const std::optional<Simul
     if (const std::string w = packingCountWarning(config, packed->particles.size()); !w.empty()) ran.warnings.push_back(w);
     ran.sample.nParticles = static_cast<int>(packed->particles.size());
     ran.sample.nParticlesGiven = true;
-    ran.sample.grading = lab::GradingConfig{.type = "packing", .diameters = {}, .passing = {}};
+    ran.sample.grading = lab::GradingConfig::ofPacking();
   }
   return ran;
 }

@@ -722,7 +722,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                                     "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
   // A packing file brings its own grains: the grading of the run is the packing's.
-  if (!c.sample.packing.empty()) c.sample.grading = lab::GradingConfig{.type = "packing", .diameters = {}, .passing = {}};
+  if (!c.sample.packing.empty()) c.sample.grading = lab::GradingConfig::ofPacking();
   if (c.sample.latticeJitter > 0.0 && c.sample.method != "lattice")
     fail("sample.lattice_jitter", fmt::format("{}", c.sample.latticeJitter), "applies to sample.method = \"lattice\" only");
   if (c.sample.method == "lattice") {

@@ -25,6 +25,15 @@ struct GradingConfig {
   double dMin = 2.0e-3;                           // [m] (uniform)
   double dMax = 8.0e-3;                           // [m] (uniform)
   std::string file;                               // (list) one diameter [m] per line/row
+
+  // The grading of a run from sample.packing: its grains are the packing's.
+  static GradingConfig ofPacking() {
+    GradingConfig g;
+    g.type = "packing";
+    g.diameters.clear();
+    g.passing.clear();
+    return g;
+  }
 };
 
 // Grain shape ([O], PHYSICS.md §1): spheres, or triaxial ellipsoids a >= b >= c of the same volume
