@@ -85,6 +85,27 @@ def main(directory):
     fig.tight_layout()
     save(fig, os.path.join(out, "overview.png"))
 
+    # Stress-dilatancy (Rowe): the stress ratio against the dilatancy rate D = -d eps_v/d eps of the
+    # monotonic curve (stress_dilatancy.csv), coloured by strain; D > 0 is dilation.
+    sd_path = os.path.join(directory, "stress_dilatancy.csv")
+    if os.path.exists(sd_path):
+        sd = read_columns(sd_path)
+        strain_key = "gamma" if "gamma" in sd else "eps1"
+        if len(sd.get(strain_key, [])) >= 2:
+            panels_sd = [("q_over_p", "stress ratio q/p"), ("R", "principal stress ratio R = sigma1/sigma3")]
+            if strain_key == "gamma":
+                panels_sd = [("tau_over_sigma_n", "stress ratio tau/sigma_n")]
+            fig, axes = plt.subplots(1, len(panels_sd), figsize=(5.5 * len(panels_sd), 4.2), squeeze=False)
+            for ax, (key, label) in zip(axes[0], panels_sd):
+                sc = ax.scatter(sd["D"], sd[key], c=[100.0 * v for v in sd[strain_key]], s=6, cmap="viridis")
+                ax.axvline(0.0, color="k", lw=0.5)
+                ax.set_xlabel("dilatancy rate D = -d eps_v / d " + ("gamma" if strain_key == "gamma" else "eps1"))
+                ax.set_ylabel(label)
+                ax.grid(alpha=0.3)
+            fig.colorbar(sc, ax=axes[0].tolist(), label=("gamma" if strain_key == "gamma" else "eps1") + " [%]")
+            fig.suptitle(title + " - stress-dilatancy", fontsize=10)
+            save(fig, os.path.join(out, "stress_dilatancy.png"))
+
     # The energy ledger of the test ([W] §4.9, Figs. 20-21): the boundaries' work against where it
     # went (stored elastic and kinetic energy, slip, rolling and damping dissipation), cumulative
     # from the start of the test, and the residual of the balance.

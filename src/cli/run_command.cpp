@@ -315,6 +315,7 @@ class RunSession {
     }
     const lab::MacroParameters m =
         simpleShear ? lab::computeSimpleShearMacro(curves) : lab::computeMacro(curves);
+    writeStressDilatancy(lab::stressDilatancy(curves, simpleShear), simpleShear);
     summary_["phi_peak_deg"] = finite(m.phiPeakDeg, "phi_peak_deg");
     summary_["eps1_at_peak"] = m.eps1AtPeak;
     summary_["q_peak"] = m.qPeak;
@@ -397,6 +398,18 @@ class RunSession {
       std::fprintf(stderr, "grainlab: warning: inertial number reached %.2e > 1e-3: the test was not quasi-static\n",
                    inertialMax);
     return writeResults(records, summary_.value("preparation_steps", 0L) + shear.steps);
+  }
+
+  // stress_dilatancy.csv: Rowe's data of the monotonic curve (lab::stressDilatancy).
+  void writeStressDilatancy(const lab::StressDilatancy& sd, bool simpleShear) {
+    std::string csv = simpleShear ? "gamma,D,tau_over_sigma_n\n" : "eps1,D,q_over_p,R\n";
+    for (std::size_t i = 0; i < sd.strain.size(); ++i) {
+      if (!std::isfinite(sd.dilatancy[i]) || !std::isfinite(sd.stressRatio[i])) continue;
+      csv += fmt::format("{:.8g},{:.8g},{:.8g}", sd.strain[i], sd.dilatancy[i], sd.stressRatio[i]);
+      if (!simpleShear) csv += fmt::format(",{:.8g}", sd.principalRatio[i]);
+      csv += "\n";
+    }
+    io::writeFileAtomic(dir_ / "stress_dilatancy.csv", csv);
   }
 
   int finishIsotropic() {

@@ -67,7 +67,8 @@ bool holdsResults(const fs::path& dir) {
 // grainlab, or by a run killed before it completed): these names, and temporary files NAME.tmpPID.
 bool grainlabName(const std::string& name) {
   static const std::set<std::string> kNames{"config.resolved.toml", "summary.json", "timeseries.csv", "packing.txt",
-                                            "checkpoint", "vtk", "micro", "plots", RunFolder::kManifest};
+                                            "checkpoint", "vtk", "micro", "plots", "stress_dilatancy.csv",
+                                            RunFolder::kManifest};
   if (kNames.count(name)) return true;
   const auto tmp = name.rfind(".tmp");
   return tmp != std::string::npos && tmp + 4 < name.size() &&

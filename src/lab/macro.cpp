@@ -137,6 +137,33 @@ void maxDilatancy(const TriaxialCurves& c, double halfWindow, PsiOf psiOf, Macro
 
 }  // namespace
 
+StressDilatancy stressDilatancy(const TriaxialCurves& c, bool simpleShear, double halfWindow) {
+  StressDilatancy out;
+  const std::size_t n = c.eps1.size();
+  if (c.epsV.size() != n || c.sigma1.size() != n || (simpleShear ? c.shearStress.size() : c.sigma3.size()) != n)
+    return out;
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (lo < n && c.eps1[lo] < c.eps1[i] - halfWindow) ++lo;
+    while (hi < n && c.eps1[hi] <= c.eps1[i] + halfWindow) ++hi;
+    if (hi - lo < 3) continue;
+    double eta = 0.0;
+    if (simpleShear) {
+      if (!(c.sigma1[i] > 0.0)) continue;
+      eta = c.shearStress[i] / c.sigma1[i];
+    } else {
+      const double q = c.sigma1[i] - c.sigma3[i], p = (c.sigma1[i] + 2.0 * c.sigma3[i]) / 3.0;
+      if (!(p > 0.0) || !(c.sigma3[i] > 0.0)) continue;
+      eta = q / p;
+      out.principalRatio.push_back(c.sigma1[i] / c.sigma3[i]);
+    }
+    out.strain.push_back(c.eps1[i]);
+    out.dilatancy.push_back(-slope(c.eps1, c.epsV, lo, hi));
+    out.stressRatio.push_back(eta);
+  }
+  return out;
+}
+
 MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s) {
   MacroParameters m;
   const std::size_t n = c.eps1.size();

@@ -89,6 +89,15 @@ double dilatancyAngleTanDeg(double rate);
 // Least-squares slope of y on x over indices [begin, end).
 double slope(const std::vector<double>& x, const std::vector<double>& y, std::size_t begin, std::size_t end);
 
+// Stress–dilatancy data of a test (Rowe's plot): at every record with a centred window of
+// +-halfWindow strain holding at least 3 records, the dilatancy rate D = -d eps_v/d eps (least
+// squares over the window; eps = eps1, or gamma in simple shear), the stress ratio eta = q/p (simple
+// shear: tau/sigma_n) and, for the axial tests, the principal stress ratio R = sigma1/sigma3.
+struct StressDilatancy {
+  std::vector<double> strain, dilatancy, stressRatio, principalRatio;  // principalRatio empty in simple shear
+};
+StressDilatancy stressDilatancy(const TriaxialCurves& c, bool simpleShear, double halfWindow = 0.005);
+
 MacroParameters computeMacro(const TriaxialCurves& c, const MacroSettings& s = {});
 // Simple shear at constant normal stress: `eps1` holds gamma, `sigma1` the normal stress, and
 // `shearStress` tau. phi = atan(tau / sigma_n); psi = atan(-d eps_v / d gamma) (positive in

@@ -155,3 +155,26 @@ TEST(Macro, NoisySteadyCurvesReachItAndShortTestsAreNotEvaluated) {
   EXPECT_FALSE(none.evaluated);
   EXPECT_FALSE(none.reached);
 }
+
+TEST(Macro, StressDilatancyDataAgainstTheSyntheticCurves) {
+  // eps_v = 0.0025 - 0.5 (eps1 - 0.01) on 1 % < eps1 < 10 %: D = 0.5 wherever the +-0.5 % window
+  // lies inside that branch; R = sigma1/sigma3 and q/p from the stresses of each record.
+  const lab::TriaxialCurves c = syntheticCurves();
+  const lab::StressDilatancy sd = lab::stressDilatancy(c, false);
+  ASSERT_EQ(sd.strain.size(), c.eps1.size());  // every record has a window of >= 3 records
+  ASSERT_EQ(sd.principalRatio.size(), sd.strain.size());
+  int checked = 0;
+  for (std::size_t i = 0; i < sd.strain.size(); ++i) {
+    const double e = sd.strain[i];
+    const double s1 = c.sigma1[i], s3 = c.sigma3[i];
+    EXPECT_NEAR(sd.principalRatio[i], s1 / s3, 1e-12);
+    EXPECT_NEAR(sd.stressRatio[i], (s1 - s3) / ((s1 + 2 * s3) / 3), 1e-12);
+    if (e > 0.0151 && e < 0.0949) {
+      EXPECT_NEAR(sd.dilatancy[i], 0.5, 1e-9) << "eps1 = " << e;
+      ++checked;
+    }
+    if (e > 0.1051) EXPECT_NEAR(sd.dilatancy[i], 0.0, 1e-9);
+    if (e < 0.0049) EXPECT_NEAR(sd.dilatancy[i], -0.25, 1e-9);  // contraction: D < 0
+  }
+  EXPECT_GT(checked, 700);
+}
