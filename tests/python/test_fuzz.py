@@ -358,6 +358,7 @@ def resumable(tmp_path_factory):
                           capture_output=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     (base / "run" / ".grainlab-manifest").unlink()
+    (base / "run" / "stress_dilatancy.csv").unlink()  # written with the results, like timeseries.csv
     return base / "run"
 
 
