@@ -777,8 +777,8 @@ int resumeLab(const ResumeOptions& opt) {
   try {
     stateio::MemoryInput in(checkpoint.state);
     session.lab().loadState(in);
+    // Laboratory::loadState validated the engine's state (Simulation::loadState) and the lab's own.
     if (in.bytesLeft() != 0) throw stateio::StateError(fmt::format("{} bytes left over after the state", in.bytesLeft()));
-    session.lab().simulation().validateState();
   } catch (const std::exception& e) {
     throw InputError(fmt::format("checkpoint {}: cannot be resumed: {}", io::quotedPath(stateFile), e.what()));
   }

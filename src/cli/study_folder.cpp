@@ -1,8 +1,6 @@
 #include "cli/study_folder.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,6 +9,7 @@
 #include "core/errors.hpp"
 #include "io/input_file.hpp"
 #include "io/results.hpp"
+#include "io/run_folder.hpp"
 
 namespace grainlab::cli {
 
@@ -33,18 +32,11 @@ StudyFolder claimStudyFolder(const fs::path& requested, const std::string& optio
     throw io::FileError(io::fileErrorMessage("cannot write into the folder", requested, errno));
   // The lock first, then the look at the folder: of two commands started at once into a new
   // folder, the second finds it locked, not empty-and-free.
-  const int fd = ::open(requested.c_str(), O_RDONLY | O_DIRECTORY | (keepLockAcrossExec ? 0 : O_CLOEXEC));
-  if (fd < 0) throw io::FileError(io::fileErrorMessage("cannot open the folder", requested, errno));
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
-    ::close(fd);
-    if (err == EWOULDBLOCK)
-      throw InputError(fmt::format("{} {}: another grainlab {} is writing into this folder now; wait for it to end "
-                                   "or give another folder",
-                                   option, io::quotedPath(requested), what));
-    throw io::FileError(io::fileErrorMessage("cannot lock the folder", requested, err));
-  }
-  // fd stays open (and the lock held) until the process ends.
+  if (io::lockFolder(requested, /*closeOnExec=*/!keepLockAcrossExec) < 0)
+    throw InputError(fmt::format("{} {}: another grainlab {} is writing into this folder now; wait for it to end "
+                                 "or give another folder",
+                                 option, io::quotedPath(requested), what));
+  // The descriptor stays open (and the lock held) until the process ends.
   const bool empty = fs::is_empty(requested, ec);
   if (ec) throw io::FileError(io::fileErrorMessage("cannot read the folder", requested, ec.value()));
   if (empty) {

@@ -114,18 +114,22 @@ void RunFolder::writeManifest(const fs::path& dir) {
   writeFileAtomic(dir / kManifest, text);
 }
 
+int lockFolder(const fs::path& dir, bool closeOnExec) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | (closeOnExec ? O_CLOEXEC : 0));
+  if (fd < 0) throw FileError(fileErrorMessage("cannot open the folder", dir, errno));
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return fd;
+  const int err = errno;
+  ::close(fd);
+  if (err == EWOULDBLOCK) return -1;
+  throw FileError(fileErrorMessage("cannot lock the folder", dir, err));
+}
+
 void RunFolder::lock() {
-  const int fd = ::open(target_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) throw FileError(fileErrorMessage("cannot open the results folder", target_, errno));
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
-    ::close(fd);
-    if (err == EWOULDBLOCK)
-      throw InputError(fmt::format("output.dir = {}: another grainlab run or resume is writing into this folder now; "
-                                   "allowed: one run per results folder at a time (give another --out, or wait)",
-                                   quotedPath(target_)));
-    throw FileError(fileErrorMessage("cannot lock the results folder", target_, err));
-  }
+  const int fd = lockFolder(target_);
+  if (fd < 0)
+    throw InputError(fmt::format("output.dir = {}: another grainlab run or resume is writing into this folder now; "
+                                 "allowed: one run per results folder at a time (give another --out, or wait)",
+                                 quotedPath(target_)));
   lock_ = std::shared_ptr<int>(new int(fd), [](int* p) {
     ::close(*p);
     delete p;

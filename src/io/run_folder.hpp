@@ -62,6 +62,11 @@ class RunFolder {
   void keepUserFiles() const;
 };
 
+// Takes an exclusive, non-blocking flock on a folder: the open descriptor that holds it (kept open
+// for as long as the lock is to be held), or -1 when another process holds it. A folder that cannot
+// be opened or locked: FileError. closeOnExec = false lets a program started by exec inherit it.
+int lockFolder(const std::filesystem::path& dir, bool closeOnExec = true);
+
 // The entries of a results folder that a user added: not in its manifest (for a folder without one,
 // an earlier grainlab's or a killed run's, not one of the names grainlab writes).
 std::vector<std::string> userEntries(const std::filesystem::path& dir);

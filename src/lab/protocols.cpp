@@ -307,7 +307,7 @@ void Laboratory::loadState(std::istream& in) {
     throw std::runtime_error("inconsistent state: unload-reload loop state does not match test.unload_reload_at");
   if (st.loopPhase == 3 && !(st.loopRestStart >= st.startStep && st.loopRestStart <= sim_.stepCount))
     throw std::runtime_error("inconsistent state: a loop's rest did not start during this test");
-  sim_.validateState();
+  // The engine's state was validated by sim_.loadState before anything was derived from it.
   if (records_.referencePosition.size() != sim_.particles.size() || records_.rotationPath.size() != sim_.particles.size() ||
       records_.referenceOrientation.size() != sim_.particles.size() || records_.sphericity.size() != sim_.particles.size())
     throw std::runtime_error("inconsistent state: grain records do not match the particles");

@@ -47,3 +47,25 @@ def grainlab():
 @pytest.fixture
 def data_dir():
     return DATA
+
+
+def kill_after_second_checkpoint(proc, state, timeout=120):
+    """Waits until the run `proc` has rewritten its checkpoint `state` once (a checkpoint beyond the
+    first, written when shearing starts), then kills it with SIGKILL. Fails if the run ended first."""
+    import signal
+    import time
+    first = None
+    deadline = time.time() + timeout
+    try:
+        while time.time() < deadline and proc.poll() is None:
+            if state.exists():
+                m = state.stat().st_mtime_ns
+                if first is None:
+                    first = m
+                elif m != first:
+                    break
+            time.sleep(0.01)
+        assert proc.poll() is None, "the run ended before it could be interrupted"
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()

@@ -6,7 +6,6 @@ import json
 import multiprocessing
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import threading
@@ -14,7 +13,7 @@ import time
 
 import pytest
 
-from conftest import GRAINLAB, TINY_CONFIG as TINY
+from conftest import GRAINLAB, TINY_CONFIG as TINY, kill_after_second_checkpoint
 
 BUILD = os.path.dirname(os.path.abspath(GRAINLAB))
 sys.path.insert(0, os.path.join(BUILD, "python"))
@@ -38,22 +37,7 @@ def write(path, text):
 def killed_during_shear(cfg, folder, extra=()):
     """Starts a run and kills it (SIGKILL) once its second checkpoint is written."""
     proc = subprocess.Popen([GRAINLAB, "run", cfg, "--out", str(folder), "--quiet", *extra])
-    state = folder / "checkpoint" / "state.bin"
-    first = None
-    deadline = time.time() + 120
-    try:
-        while time.time() < deadline and proc.poll() is None:
-            if state.exists():
-                m = state.stat().st_mtime_ns
-                if first is None:
-                    first = m
-                elif m != first:
-                    break
-            time.sleep(0.01)
-        assert proc.poll() is None, "the run ended before it could be interrupted"
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+    kill_after_second_checkpoint(proc, folder / "checkpoint" / "state.bin")
     assert not (folder / "summary.json").exists()
 
 

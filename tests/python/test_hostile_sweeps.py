@@ -79,6 +79,18 @@ def snapshot(folder):
     return out
 
 
+def assert_nothing_left(folder, outlived, still_writing):
+    """No process names `folder` within 5 s, and nothing changes in it for 1.5 s after that."""
+    for _ in range(100):
+        if not processes_mentioning(str(folder)):
+            break
+        time.sleep(0.05)
+    assert not processes_mentioning(str(folder)), outlived
+    before = snapshot(folder)
+    time.sleep(1.5)
+    assert snapshot(folder) == before, still_writing
+
+
 # ---- 1. the grid's keys and values -------------------------------------------------------------
 
 @pytest.mark.parametrize("args, words", [
@@ -246,14 +258,7 @@ def test_stopped_sweep_leaves_no_case_running(tiny, tmp_path, sig):
     sweep.send_signal(sig)
     stdout, stderr = sweep.communicate(timeout=60)
     assert sweep.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 128 + sig), stderr
-    for _ in range(100):
-        if not processes_mentioning(str(out)):
-            break
-        time.sleep(0.05)
-    assert not processes_mentioning(str(out)), "a case outlived its sweep"
-    before = snapshot(out)
-    time.sleep(1.5)
-    assert snapshot(out) == before, "something still writes into the sweep's folder"
+    assert_nothing_left(out, "a case outlived its sweep", "something still writes into the sweep's folder")
     if sig != signal.SIGKILL:
         assert stderr.count("\n") == 1 and f"interrupted by {signal.Signals(sig).name}" in stderr, stderr
         assert "0 of 3 cases completed, 2 stopped, 1 not run" in stderr
@@ -338,14 +343,7 @@ def test_sigterm_to_a_calibration_leaves_no_run(grainlab, tmp_path):
     _, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 143, stderr
     assert "interrupted (SIGTERM)" in stderr and "resumes" in stderr and "Traceback" not in stderr
-    for _ in range(100):
-        if not processes_mentioning(str(folder)):
-            break
-        time.sleep(0.05)
-    assert not processes_mentioning(str(folder)), "a run outlived the calibration"
-    before = snapshot(folder)
-    time.sleep(1.5)
-    assert snapshot(folder) == before
+    assert_nothing_left(folder, "a run outlived the calibration", "something still writes into the calibration's folder")
 
 
 # ---- 6. empty values ---------------------------------------------------------------------------

@@ -2,11 +2,9 @@
 checkpoint ends with the same numbers, bit for bit, as the same run left alone."""
 import json
 import os
-import signal
 import subprocess
-import time
 
-from conftest import GRAINLAB
+from conftest import GRAINLAB, kill_after_second_checkpoint
 
 SETS = ["--set", "sample.n_particles=150", "--set", "test.final_axial_strain=0.03",
         "--set", "output.checkpoint_every=0.004", "--set", "output.vtk_every_strain=0.01",
@@ -30,21 +28,8 @@ def test_kill_and_resume_is_bit_identical(grainlab, data_dir, tmp_path):
 
     cut = tmp_path / "cut"
     proc = subprocess.Popen([GRAINLAB, "run", config, "--out", str(cut), *SETS])
-    state = cut / "checkpoint" / "state.bin"
-    deadline = time.time() + 300
-    # Wait for a checkpoint beyond the first (written when shearing starts), then kill -9.
-    first = None
-    while time.time() < deadline and proc.poll() is None:
-        if state.exists():
-            m = state.stat().st_mtime_ns
-            if first is None:
-                first = m
-            elif m != first:
-                break
-        time.sleep(0.05)
-    assert proc.poll() is None, "the run finished before it could be interrupted"
-    proc.send_signal(signal.SIGKILL)
-    proc.wait()
+    # A checkpoint beyond the first (written when shearing starts), then kill -9.
+    kill_after_second_checkpoint(proc, cut / "checkpoint" / "state.bin", timeout=300)
     assert not (cut / "summary.json").exists()
     assert not (cut / "timeseries.csv").exists()
 

@@ -14,7 +14,7 @@ import time
 
 import pytest
 
-from conftest import GRAINLAB, TINY_CONFIG as TINY
+from conftest import GRAINLAB, TINY_CONFIG as TINY, kill_after_second_checkpoint
 
 
 
@@ -224,21 +224,7 @@ def interrupted(tmp_path_factory):
     folder = base / "run"
     proc = subprocess.Popen([GRAINLAB, "run", cfg, "--out", str(folder), "--quiet"])
     state = folder / "checkpoint" / "state.bin"
-    first = None
-    deadline = time.time() + 120
-    try:
-        while time.time() < deadline and proc.poll() is None:
-            if state.exists():
-                m = state.stat().st_mtime_ns
-                if first is None:
-                    first = m
-                elif m != first:
-                    break
-            time.sleep(0.02)
-        assert proc.poll() is None, "the run ended before it could be interrupted"
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+    kill_after_second_checkpoint(proc, state)
     assert not (folder / "summary.json").exists()
     return folder, state.read_bytes()
 
