@@ -21,7 +21,7 @@ import math
 import os
 import sys
 
-from study_runs import completed, residual_state, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
+from study_runs import completed, elastic_nu, residual_state, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -125,7 +125,7 @@ def report(args):
     for case, label, seed, _, sm, s in found:
         lines.append(
             f"| {label} | {seed} | {sm['e0']:.3f} | {sm['Z']:.2f} | {fmt(sm.get('Z_mech'), '.2f')} | "
-            f"{'yes' if sm.get('house_of_cards') else 'no'} | {fmt(sm.get('E0_MPa'), '.0f')} | {fmt(sm.get('nu0'), '.3f')} | "
+            f"{'yes' if sm.get('house_of_cards') else 'no'} | {fmt(sm.get('E0_MPa'), '.0f')} | {fmt(elastic_nu(sm.get('nu0')), '.3f')} | "
             f"{fmt(sm.get('E50_MPa'), '.0f')} | {sm['phi_peak_deg']:.1f} | {sm['phi_res_deg']:.1f} | "
             f"{sm['phi_peak_deg'] - sm['phi_res_deg']:.1f} | {fmt(sm.get('psi_max_deg'), '.1f')} | "
             f"{100 * s['eps_v'][-1]:.2f} | {residual_state(sm)[0]:.2f} | {residual_state(sm)[1]:.3f} | "

@@ -15,7 +15,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_runs import run_cases, summary, write_table  # noqa: E402
+from study_runs import positive_modulus, run_cases, summary, write_table  # noqa: E402
 
 LOOPS = ["test.unload_reload_at=[0.005,0.02]", "test.final_axial_strain=0.03"]
 AUTO_RATE_W = 1.1923383855050151  # the auto rate of w-base (I = 0.98e-3), from its summary.json
@@ -64,7 +64,7 @@ def main():
              "|---|---:|---:|---:|---:|---:|---:|"]
     for name, _, label, _ in CASES:
         s = summary(os.path.join(a.runs, name))
-        eur = s["Eur_MPa"]
+        eur = [positive_modulus(v) for v in s["Eur_MPa"]]
         relax = [fmt(100 * r if r is not None else None, ".1f") for r in s.get("Eur_rest_q_relaxation") or [None, None]]
         lines.append(f"| {label} | {s['E0_MPa']:.0f} | {s['E50_MPa']:.0f} | {' / '.join(relax)} | {fmt(eur[0], '.0f')} | "
                      f"{fmt(eur[1], '.0f')} | {fmt(eur[0] / s['E0_MPa'] if eur[0] is not None else None, '.2f')} |")

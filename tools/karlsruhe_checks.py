@@ -16,7 +16,7 @@ import csv
 import os
 import sys
 
-from study_runs import completed, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
+from study_runs import completed, elastic_nu, run_cases, summary, write_table  # noqa: E402 (tools/, beside this script)
 
 import matplotlib
 
@@ -76,7 +76,7 @@ def report(a):
             f"| {label} | {s['e0']:.3f} | {s['Z']:.2f} | {fmt(s.get('phi_peak_deg'))} | "
             f"{fmt(100 * s['eps1_at_peak'] if s.get('eps1_at_peak') is not None else None)} | "
             f"{fmt(s.get('psi_max_deg'))} | {fmt(s.get('phi_res_deg'))} | {fmt(s.get('E50_MPa'), 0)} | "
-            f"{fmt(s.get('E0_MPa'), 0)} | {fmt(s.get('nu0'), 2)} | {100 * epsv[-1]:.2f} | {fmt(qp_end, 2)} | "
+            f"{fmt(s.get('E0_MPa'), 0)} | {fmt(elastic_nu(s.get('nu0')), 2)} | {100 * epsv[-1]:.2f} | {fmt(qp_end, 2)} | "
             f"{fmt(e_end, 3)} | {fmt(100 * dev if dev is not None else None)} | {s['wall_seconds']:.0f} |")
         pc = s["confining_pressure"]
         ax_q.plot([100 * x for x in eps1], [y / pc for y in q], label=label)

@@ -45,12 +45,17 @@ def main(directory):
         pass
     out = os.path.join(directory, "plots")
     os.makedirs(out, exist_ok=True)
-    eps1 = [100.0 * v for v in data["eps1"]]
+    # Simple shear is plotted against gamma with tau in the first panel (eps1 is then the dilation
+    # of the cell height); the file names stay those of the triaxial plots.
+    shear = "gamma" in data and "tau" in data
+    strain_name = "shear strain gamma [%]" if shear else "axial strain eps1 [%]"
+    eps1 = [100.0 * v for v in data["gamma" if shear else "eps1"]]
     title = "e0 = {:.3f}, p = {:.0f} kPa, N = {}".format(
         summary.get("e0", float("nan")), summary.get("confining_pressure", 0) / 1e3,
         summary.get("n_particles", "?"))
 
     panels = [
+        ("q_eps1.png", [v / 1e3 for v in data["tau"]], "shear stress tau [kPa]") if shear else
         ("q_eps1.png", [v / 1e3 for v in data["q"]], "deviator stress q [kPa]"),
         ("epsv_eps1.png", [100.0 * v for v in data["eps_v"]], "volumetric strain eps_v [%] (contraction +)"),
         ("phi_eps1.png", data["phi_deg"], "mobilised friction angle phi [deg]"),
@@ -59,7 +64,7 @@ def main(directory):
     for name, y, label in panels:
         fig, ax = plt.subplots(figsize=(6, 4.2))
         ax.plot(eps1, y, lw=1.4)
-        ax.set_xlabel("axial strain eps1 [%]")
+        ax.set_xlabel(strain_name)
         ax.set_ylabel(label)
         ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
@@ -78,7 +83,7 @@ def main(directory):
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     for ax, (name, y, label) in zip(axes.flat, panels):
         ax.plot(eps1, y, lw=1.2)
-        ax.set_xlabel("eps1 [%]")
+        ax.set_xlabel("gamma [%]" if shear else "eps1 [%]")
         ax.set_ylabel(label, fontsize=8)
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)

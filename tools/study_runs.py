@@ -32,6 +32,18 @@ def residual_state(summary):
     return summary.get("cs_q_over_p"), summary.get("cs_void_ratio")
 
 
+def elastic_nu(value):
+    """A Poisson ratio for a table: None (printed null) outside [0, 0.5], where the probe did not
+    measure an isotropic elastic response; summaries written since then already say null."""
+    return value if value is not None and 0.0 <= value <= 0.5 else None
+
+
+def positive_modulus(value):
+    """A modulus for a table: None (printed null) unless positive (a negative reload secant is a
+    sample that kept collapsing through its loop, not a stiffness)."""
+    return value if value is not None and value > 0.0 else None
+
+
 def write_table(path, lines, header=""):
     """Writes the table's lines (after an optional header line) to path and prints them."""
     with open(path, "w") as f:

@@ -30,7 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_runs import residual_state  # noqa: E402 (tools/, beside this script)
+from study_runs import elastic_nu, residual_state  # noqa: E402 (tools/, beside this script)
 
 # (study, key, values, base value, label, how a value is printed)
 BASE = {"contact.beta": 0.15, "contact.eta": 1.0, "contact.friction_deg": 30.0,
@@ -45,6 +45,12 @@ STUDIES = [
     ("Ec", "contact.young", [3e9, 30e9], "Ec [GPa]"),
     ("p", "test.confining_pressure", [100e3, 300e3], "p [kPa]"),
 ]
+
+
+def nu_text(summary):
+    """nu of the summary for the table: null outside [0, 0.5] (study_runs.elastic_nu)."""
+    nu = elastic_nu(summary.get("nu"))
+    return "null" if nu is None else f"{nu:.2f}"
 
 
 def show(key, value):
@@ -182,7 +188,7 @@ def report(opt):
             lines.append(
                 f"| {study} | {name} | {summary['e0']:.3f} | {summary['phi_peak_deg']:.1f} | "
                 f"{100 * summary['eps1_at_peak']:.2f} | {summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | "
-                f"{summary['E_MPa']:.0f} | {summary['E50_MPa']:.0f} | {summary['nu']:.2f} | "
+                f"{summary['E_MPa']:.0f} | {summary['E50_MPa']:.0f} | {nu_text(summary)} | "
                 f"{residual_state(summary)[0]:.2f} | {residual_state(summary)[1]:.3f} | "
                 f"{summary['inertial_number_max']:.2e} | {100 * summary['lateral_stress_max_deviation']:.1f} | "
                 f"{summary['wall_seconds']:.0f} |")

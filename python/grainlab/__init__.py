@@ -365,6 +365,14 @@ class SweepResult:
         self.table = _read_table(os.path.join(self.folder, "sweep.csv"))
 
     @property
+    def stats(self):
+        """The rows of sweep-stats.csv (a sweep with seeds >= 2: per case of the other keys, each
+        quantity's _mean, _std, _min, _max and _n over its seeds; NaN where not measured) as a
+        structured array, else None."""
+        path = os.path.join(self.folder, "sweep-stats.csv")
+        return _read_table(path) if os.path.exists(path) else None
+
+    @property
     def cases(self):
         """{case name: Result} of the cases that left a summary."""
         out = {}
@@ -381,19 +389,26 @@ class SweepResult:
         return f"grainlab.SweepResult({self.folder!r}, {len(self.table)} cases)"
 
 
-def sweep(config, vary, out=None, client=None, set=None, jobs=None, threads=None, quiet=True):
+def sweep(config, vary=None, out=None, client=None, set=None, jobs=None, threads=None, quiet=True, seeds=None):
     """A grid of runs and their comparison table: `grainlab sweep` of the installed program.
 
-    vary: {"contact.beta": [0, 0.15], ...} (a grid over every key). client: a
+    vary: {"contact.beta": [0, 0.15], ...} (a grid over every key). seeds: N replicate seeds per
+    case (sample.seed, +1, ..., +N-1; `--seeds`), whose statistics are SweepResult.stats. client: a
     dask.distributed.Client whose scheduler runs the cases (`--scheduler`), else local processes,
     `jobs` at a time. Returns a SweepResult; raises ConfigError for a refused config or vary."""
     cfg = _config(config, set)
+    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, numbers.Integral)
+                              or not 1 <= seeds <= 1000):
+        raise ConfigError(f"seeds = {seeds!r:.80}; allowed: None or an integer in [1, 1000]")
     out = _folder(out)
     threads = _threads(threads)
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral) or not 1 <= jobs <= 4096):
         raise ConfigError(f"jobs = {jobs!r:.80}; allowed: None or an integer in [1, 4096]")
-    if not isinstance(vary, dict) or not vary:
-        raise ConfigError(f"sweep: vary = {vary!r:.80}; allowed: a non-empty dict {{key: [values]}}")
+    if vary is None and seeds is not None and seeds >= 2:
+        vary = {}
+    elif not isinstance(vary, dict) or not vary:
+        raise ConfigError(f"sweep: vary = {vary!r:.80}; allowed: a non-empty dict {{key: [values]}}, or None "
+                          "with seeds >= 2")
     if out is not None and os.fspath(out) in ("", b""):
         # The program would take an empty --out for "not given" (runs/sweep): refused.
         raise ConfigError("sweep: out = '': empty; give a folder, or None for runs/sweep")
@@ -410,6 +425,8 @@ def sweep(config, vary, out=None, client=None, set=None, jobs=None, threads=None
             argv += ["--jobs", str(int(jobs))]
         if threads:
             argv += ["--threads", str(int(threads))]
+        if seeds is not None:
+            argv += ["--seeds", str(int(seeds))]
         if client is not None:
             argv += ["--scheduler", client.scheduler.address]
         if quiet:

@@ -45,6 +45,7 @@ struct SweepOptions {
   std::vector<std::string> overrides;  // --set applied to every case
   std::string outDir;
   int jobs = 2;
+  int seeds = 1;    // replicate seeds per case (sample.seed, +1, ...); > 1 adds sweep-stats.csv/.md
   int threads = 0;  // per case; 0: from the config
   bool quiet = false;
   std::string scheduler;   // tcp://HOST:PORT: cases run on that Dask cluster (sweep_dask.hpp)

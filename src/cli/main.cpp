@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
   cli::SweepOptions sweep;
   auto* sweepCmd = app.add_subcommand("sweep", "Run a grid of overrides in parallel processes and compare them");
   sweepCmd->add_option("config", sweep.config, "CONFIG.toml or preset:NAME")->check(kNonEmpty)->required();
-  sweepCmd->add_option("--vary", sweep.vary, "KEY=V1,V2,... (repeat for a grid)")->required()->allow_extra_args(false);
+  sweepCmd->add_option("--vary", sweep.vary, "KEY=V1,V2,... (repeat for a grid)")->allow_extra_args(false);
+  sweepCmd->add_option("--seeds", sweep.seeds, "replicate seeds per case: sample.seed, +1, ..., +N-1; adds sweep-stats.csv/.md")
+      ->capture_default_str();
   sweepCmd->add_option("--set", sweep.overrides, "override applied to every case")->allow_extra_args(false);
   sweepCmd->add_option("--jobs", sweep.jobs, "cases run at once")->capture_default_str();
   sweepCmd->add_option("--threads", sweep.threads, "threads per case (default: cores / jobs when jobs > 1, else solver.threads)")

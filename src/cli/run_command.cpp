@@ -72,10 +72,27 @@ std::string shown(const json& v, const char* format) {
 
 // The small-strain probe in the summary (lab/moduli.hpp). E_MPa and nu repeat E0_MPa and nu0 for
 // readers of earlier summaries.
+// A probe whose nu0 leaves [0, 0.5] or whose E0 is not positive did not measure an isotropic elastic
+// response (the probe strain reached slip or collapse): the value is null, the number the probe
+// gave stays in nu0_measured / E0_MPa_measured, and a warning says so.
 void probeJson(const lab::ModulusProbe& probe, json& s) {
   const bool ok = probe.elastic.has_value();
   s["E0_MPa"] = ok ? json(finite(probe.elastic->young / 1e6, "E0_MPa")) : json(nullptr);
   s["nu0"] = ok ? json(finite(probe.elastic->poisson, "nu0")) : json(nullptr);
+  if (ok && (probe.elastic->poisson < 0.0 || probe.elastic->poisson > 0.5)) {
+    s["nu0_measured"] = s["nu0"];
+    s["nu0"] = nullptr;
+    s["warnings"].push_back(fmt::format("nu0 = {:.3f} from the probe is outside [0, 0.5], not an elastic Poisson ratio; "
+                                        "reported as null (nu0_measured keeps it)",
+                                        probe.elastic->poisson));
+  }
+  if (ok && probe.elastic->young <= 0.0) {
+    s["E0_MPa_measured"] = s["E0_MPa"];
+    s["E0_MPa"] = nullptr;
+    s["warnings"].push_back(fmt::format("E0 = {:.4g} MPa from the probe is not positive; reported as null "
+                                        "(E0_MPa_measured keeps it)",
+                                        probe.elastic->young / 1e6));
+  }
   s["E0_method"] = probe.method;
   s["E0_probe"] = {{"strain", probe.strain}, {"d_sigma1", probe.dSigma1}, {"d_sigma3", probe.dSigma3},
                    {"d_eps1", probe.dEps1}, {"d_eps3", probe.dEps3}, {"steps", probe.steps},
@@ -426,13 +443,26 @@ class RunSession {
       summary_["Eur_method"] = "not measured (no test.unload_reload_at)";
       return;
     }
-    json eur = json::array(), at = json::array(), relaxed = json::array();
+    json eur = json::array(), at = json::array(), relaxed = json::array(), measured = json::array();
+    bool rejected = false;
     for (const auto& l : loops) {
-      eur.push_back(l.eur ? json(finite(*l.eur / 1e6, "Eur_MPa")) : json(nullptr));
+      // A reload secant that is not positive (the sample kept collapsing through the loop) is not an
+      // unload-reload modulus: null, with the number in Eur_MPa_measured and a warning.
+      const bool positive = l.eur && *l.eur > 0.0;
+      measured.push_back(l.eur ? json(finite(*l.eur / 1e6, "Eur_MPa")) : json(nullptr));
+      eur.push_back(positive ? measured.back() : json(nullptr));
+      if (l.eur && !positive) {
+        rejected = true;
+        summary_["warnings"].push_back(fmt::format(
+            "Eur = {:.4g} MPa of the loop at eps1 = {:.4g} is not positive (the reload did not stiffen the sample); "
+            "reported as null (Eur_MPa_measured keeps it)",
+            *l.eur / 1e6, l.eps1Reversal));
+      }
       at.push_back(l.eps1Reversal);
       relaxed.push_back(l.restRelaxation ? json(finite(*l.restRelaxation, "Eur_rest_q_relaxation")) : json(nullptr));
     }
     summary_["Eur_MPa"] = eur;
+    if (rejected) summary_["Eur_MPa_measured"] = measured;
     summary_["Eur_at_eps1"] = at;
     // The fraction of q lost at constant strain during the rest before each unload (null: no rest).
     summary_["Eur_rest_q_relaxation"] = relaxed;

@@ -28,6 +28,7 @@
 #include "io/install_paths.hpp"
 #include "io/process.hpp"
 #include "io/results.hpp"
+#include "lab/replicates.hpp"
 
 namespace grainlab::cli {
 
@@ -41,6 +42,8 @@ namespace {
 constexpr double kMaxSweepCases = 10000;
 // The most cases run at once (--jobs): each is a process.
 constexpr int kMaxJobs = 1024;
+// The most replicate seeds per case (--seeds).
+constexpr int kMaxSeeds = 1000;
 constexpr const char* kMarker = "sweep.json";
 constexpr const char* kMarkerFormat = "grainlab-sweep-1";
 
@@ -240,18 +243,122 @@ bool finishedEarlier(const fs::path& dir, std::uint64_t fingerprint) {
   }
 }
 
+// sweep-stats.csv and sweep-stats.md (--seeds N): one row per case of the other --vary lists, over
+// its N seeds (consecutive cases: the seed is the grid's innermost dimension). Every quantity as
+// mean, sample standard deviation, min, max and n (the seeds that measured it: a null, or a seed
+// that did not complete, is left out and counted, never taken as 0); critical_state_reached as the
+// fraction of the seeds that reached it.
+void writeSeedStatistics(const fs::path& out, const std::vector<Vary>& varies, std::size_t seedDim,
+                         const std::vector<std::vector<std::pair<std::string, std::string>>>& cases,
+                         const std::vector<json>& summaries, const std::vector<std::string>& columns) {
+  const std::size_t seeds = varies[seedDim].values.size();
+  std::string csv;
+  for (std::size_t d = 0; d < varies.size(); ++d)
+    if (d != seedDim) csv += csvField(varies[d].key) + ",";
+  csv += "seeds,seeds_completed";
+  for (const auto& c : columns)
+    for (const char* part : {"_mean", "_std", "_min", "_max", "_n"}) csv += "," + c + part;
+  csv += "\n";
+  // The Markdown table: the quantities a results page quotes, as mean +- std (n >= 3) or the range.
+  static const std::vector<std::pair<std::string, int>> shown{
+      {"e0", 3},           {"phi_peak_deg", 1},      {"phi_res_deg", 1},   {"psi_max_deg", 1},
+      {"psi_max_tan_deg", 1}, {"E50_MPa", 0},        {"end_q_over_p", 3},  {"end_void_ratio", 3},
+      {"critical_state_reached", -1}};
+  std::string md = "| ";
+  for (std::size_t d = 0; d < varies.size(); ++d)
+    if (d != seedDim) md += varies[d].key + " | ";
+  md += "seeds |";
+  for (const auto& [c, digits] : shown) md += " " + c + " |";
+  md += "\n|";
+  for (std::size_t d = 0; d < varies.size() + shown.size(); ++d) md += "---|";
+  md += "\n";
+  for (std::size_t first = 0; first < cases.size(); first += seeds) {
+    std::size_t done = 0;
+    for (std::size_t k = 0; k < seeds; ++k)
+      if (summaries[first + k].is_object()) ++done;
+    for (std::size_t d = 0; d < varies.size(); ++d)
+      if (d != seedDim) {
+        csv += csvField(cases[first][d].second) + ",";
+        md += "| " + cases[first][d].second + " ";
+      }
+    csv += fmt::format("{},{}", seeds, done);
+    md += fmt::format("| {} of {} |", done, seeds);
+    std::map<std::string, lab::ReplicateStats> stats;
+    for (const auto& c : columns) {
+      std::vector<std::optional<double>> values;
+      for (std::size_t k = 0; k < seeds; ++k) {
+        const json& s = summaries[first + k];
+        std::optional<double> v;
+        if (s.is_object() && s.contains(c) && s[c].is_number()) v = s[c].get<double>();
+        if (s.is_object() && s.contains(c) && s[c].is_boolean()) v = s[c].get<bool>() ? 1.0 : 0.0;
+        values.push_back(v);
+      }
+      const lab::ReplicateStats st = lab::replicateStats(values);
+      stats[c] = st;
+      for (double x : {st.mean, st.std, st.min, st.max})
+        csv += std::isfinite(x) ? fmt::format(",{:.8g}", x) : std::string(",");
+      csv += fmt::format(",{}", st.n);
+    }
+    for (const auto& [c, digits] : shown) {
+      const lab::ReplicateStats& st = stats[c];
+      if (digits < 0)
+        md += st.n == 0 ? " null |" : fmt::format(" {:.0f} of {} |", st.mean * static_cast<double>(st.n), st.n);
+      else
+        md += " " + lab::formatReplicates(st, digits) + " |";
+    }
+    csv += "\n";
+    md += "\n";
+  }
+  io::writeFileAtomic(out / "sweep-stats.csv", csv);
+  io::writeFileAtomic(out / "sweep-stats.md",
+                      fmt::format("Over {} seeds per case (sample.seed {} to {}): mean ± sample standard deviation "
+                                  "for 3 or more seeds, the range [min, max] for 2; (n of N) where only n seeds "
+                                  "measured the value.\n\n",
+                                  seeds, varies[seedDim].values.front(), varies[seedDim].values.back()) +
+                          md);
+}
+
 const char* signalName(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "SIGTERM"; }
 
 }  // namespace
 
 int runSweep(const SweepOptions& opt) {
-  if (opt.vary.empty()) throw InputError("sweep: give at least one --vary KEY=V1,V2,...");
+  if (opt.seeds < 1 || opt.seeds > kMaxSeeds)
+    throw InputError(fmt::format("--seeds = {}: must be in [1, {}]", opt.seeds, kMaxSeeds));
+  if (opt.vary.empty() && opt.seeds < 2)
+    throw InputError("sweep: give at least one --vary KEY=V1,V2,... or --seeds N (N >= 2 replicate seeds)");
   if (opt.jobs < 1 || opt.jobs > kMaxJobs)
     throw InputError(fmt::format("--jobs = {}: must be in [1, {}]", opt.jobs, kMaxJobs));
   if (!opt.scheduler.empty()) checkSchedulerAddress(opt.scheduler, "--scheduler");
   std::vector<Vary> varies;
   for (const auto& spec : opt.vary) varies.push_back(parseVary(spec));
   checkKeys(varies, opt.overrides);
+  const toml::table base = io::loadConfigTable(opt.config);
+  // --seeds N: the innermost dimension of the grid, sample.seed = s0, s0 + 1, ..., s0 + N - 1 with
+  // s0 the config's seed (after --set), so the first replicate is the case a sweep without --seeds
+  // runs. Refused where a seed cannot change the sample, or where the seed is varied already.
+  std::size_t seedDim = 0;  // index of the seed dimension in varies, when seeds > 1
+  if (opt.seeds > 1) {
+    for (const auto& v : varies)
+      if (covers(v.parts, {"sample", "seed"}))
+        throw InputError(fmt::format("--seeds {}: sample.seed is varied too (--vary {}); give the seeds one way",
+                                     opt.seeds, cut(v.spec)));
+    toml::table table = base;
+    for (const auto& s : opt.overrides) io::applyOverride(table, s);
+    const lab::RunConfig config = io::parseConfig(table, io::configBaseDir(opt.config), false);
+    if (!config.sample.packing.empty())
+      throw InputError(fmt::format("--seeds {}: the sample is read from sample.packing = {}, so a seed cannot change "
+                                   "it; replicate packings are separate runs",
+                                   opt.seeds, io::quotedPath(config.sample.packing)));
+    if (config.sample.seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) -
+                                 static_cast<std::uint64_t>(opt.seeds))
+      throw InputError(fmt::format("--seeds {}: sample.seed = {} leaves no room for {} seeds after it", opt.seeds,
+                                   config.sample.seed, opt.seeds));
+    Vary seeds{fmt::format("--seeds {}", opt.seeds), "sample.seed", {"sample", "seed"}, {}};
+    for (int k = 0; k < opt.seeds; ++k) seeds.values.push_back(std::to_string(config.sample.seed + k));
+    seedDim = varies.size();
+    varies.push_back(std::move(seeds));
+  }
   checkGridSize(varies);
 
   // The grid: every combination, the last --vary changing fastest.
@@ -270,7 +377,6 @@ int runSweep(const SweepOptions& opt) {
   // Every case is validated before any starts: bad input is exit 2 with the usual message. Two
   // cases that resolve to the same config would be one run under two labels (values the config
   // reads the same, e.g. 1 and 1.0): refused.
-  const toml::table base = io::loadConfigTable(opt.config);
   std::vector<std::uint64_t> hashes(cases.size());
   std::map<std::uint64_t, std::size_t> byHash;
   for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -302,6 +408,7 @@ int runSweep(const SweepOptions& opt) {
                                             {"config", source},
                                             {"set", opt.overrides},
                                             {"grid", grid},
+                                            {"seeds", opt.seeds},
                                             {"cases", names}}
                                                .dump(1) +
                                            "\n");
@@ -421,10 +528,11 @@ int runSweep(const SweepOptions& opt) {
   csv += "\n";
   std::size_t completed = 0, failed = 0, notRun = 0, interrupted = 0;
   std::string firstFailed;
+  std::vector<json> summaries(cases.size());
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Job& job = jobs[i];
     const bool ok = job.state == State::Kept || job.state == State::Completed;
-    nlohmann::json summary;
+    json& summary = summaries[i];
     if (ok) {
       try {
         summary = nlohmann::json::parse(
@@ -466,6 +574,7 @@ int runSweep(const SweepOptions& opt) {
     csv += "\n";
   }
   io::writeFileAtomic(out / "sweep.csv", csv);
+  if (opt.seeds > 1) writeSeedStatistics(out, varies, seedDim, cases, summaries, columns);
   // Overlay plots: tools/plot_sweep.py with an argument vector (no shell), output discarded.
   const fs::path script = io::toolScript("plot_sweep.py");
   if (stopped) {

@@ -360,3 +360,17 @@ def test_sweep_and_run_refuse_with_the_cli_line(tmp_path):
     with pytest.raises(grainlab.ConfigError, match="mine"):
         grainlab.run("quick-triaxial", set=SMALL, out=tmp_path / "mine", threads=1)
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_sweep_with_seeds_gives_the_statistics_table(tmp_path):
+    swept = grainlab.sweep("quick-triaxial", set=dict(SMALL, **{"sample.n_particles": 60}), seeds=2,
+                           out=tmp_path / "seeds", threads=1)
+    assert list(swept.table["sample.seed"]) == [1, 2]
+    stats = swept.stats
+    assert len(stats) == 1 and stats["seeds_completed"][0] == 2
+    phi = swept.table["phi_peak_deg"]
+    assert stats["phi_peak_deg_min"][0] == phi.min() and stats["phi_peak_deg_max"][0] == phi.max()
+    with pytest.raises(grainlab.ConfigError, match="seeds"):
+        grainlab.sweep("quick-triaxial", seeds=0, out=tmp_path / "bad")
+    with pytest.raises(grainlab.ConfigError, match="vary"):
+        grainlab.sweep("quick-triaxial", out=tmp_path / "bad")
