@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <random>
 #include <string_view>
@@ -60,6 +61,60 @@ json equilibriumJson(const lab::EquilibriumState& s) {
           {"contact_stress", {s.contactStress(0, 0), s.contactStress(1, 1), s.contactStress(2, 2)}},
           {"unbalanced", s.unbalanced},
           {"void_ratio", s.voidRatio}};
+}
+
+// q/p of three normal stresses (axial z first), NaN where p is not positive.
+double stressRatio(double s1, double s2, double s3) {
+  const double p = (s1 + s2 + s3) / 3.0;
+  return p > 0.0 ? (s1 - 0.5 * (s2 + s3)) / p : std::numeric_limits<double>::quiet_NaN();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// The gap between the boundary's q/p (timeseries sigma1..3: means over the recording interval) and
+// the contact stress's q/p (Love-Weber at the record's step), relative to the former, over the
+// records with q/p > 0.05, and its two causes: the recording interval's mean against the step's
+// value, and the grains' net contact forces (lab::unbalancedStress: wall stress = contact stress +
+// that, exactly, at any step). `residual_max_abs` is what the two leave unexplained.
+json stressGapJson(const std::vector<lab::Record>& records, std::size_t peak) {
+  std::vector<double> gap, averaging, unbalanced;
+  double residual = 0.0;
+  auto rel = [](const lab::Record& r) {
+    const double b = r.q / r.p, c = stressRatio(r.sigma1Contact, r.sigma2Contact, r.sigma3Contact);
+    return (c - b) / b;
+  };
+  for (const auto& r : records) {
+    const double b = r.p > 0.0 ? r.q / r.p : 0.0;
+    if (!(b > 0.05)) continue;
+    const double now = stressRatio(r.sigma1Now, r.sigma2Now, r.sigma3Now);
+    const double c = stressRatio(r.sigma1Contact, r.sigma2Contact, r.sigma3Contact);
+    const double cu = stressRatio(r.sigma1Contact + r.sigma1Unbalanced, r.sigma2Contact + r.sigma2Unbalanced,
+                                  r.sigma3Contact + r.sigma3Unbalanced);
+    if (!std::isfinite(now) || !std::isfinite(c) || !std::isfinite(cu)) continue;
+    gap.push_back((c - b) / b);
+    averaging.push_back(std::abs(now - b) / b);
+    unbalanced.push_back(std::abs(cu - c) / b);
+    residual = std::max(residual, std::abs(cu - now) / b);
+  }
+  if (gap.empty()) return nullptr;
+  double maxAbs = 0.0;
+  for (double g : gap) maxAbs = std::max(maxAbs, std::abs(g));
+  auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"definition",
+           "(q/p of the Love-Weber contact stress at the record's step - q/p of the recorded boundary stress) / the "
+           "latter, over the records with q/p > 0.05"},
+          {"records", gap.size()},
+          {"median", median(gap)},
+          {"max_abs", maxAbs},
+          {"at_peak", number(records[peak].p > 0.0 ? rel(records[peak]) : std::nan(""))},
+          {"end", number(records.back().p > 0.0 ? rel(records.back()) : std::nan(""))},
+          {"recording_mean_part_median_abs", median(averaging)},
+          {"net_force_part_median_abs", median(unbalanced)},
+          {"residual_max_abs", residual}};
 }
 
 // A summary number for the console, or "null".
@@ -330,8 +385,11 @@ class RunSession {
       curves.voidRatio.push_back(r.e);
       curves.shearStress.push_back(r.tau);
     }
+    lab::MacroSettings criterion;
+    criterion.csWindow = config_.test.csWindow.value_or(
+        lab::autoCsWindow(simpleShear ? config_.test.finalShearStrain : config_.test.finalAxialStrain));
     const lab::MacroParameters m =
-        simpleShear ? lab::computeSimpleShearMacro(curves) : lab::computeMacro(curves);
+        simpleShear ? lab::computeSimpleShearMacro(curves, criterion) : lab::computeMacro(curves, criterion);
     writeStressDilatancy(lab::stressDilatancy(curves, simpleShear), simpleShear);
     summary_["phi_peak_deg"] = finite(m.phiPeakDeg, "phi_peak_deg");
     summary_["eps1_at_peak"] = m.eps1AtPeak;
@@ -357,7 +415,6 @@ class RunSession {
     // The critical state only where the steady-state criterion (lab/macro.hpp) was met; the end of
     // the test always, with its rates, so that a sample still dilating says so.
     const lab::SteadyState& cs = m.steady;
-    const lab::MacroSettings criterion;
     summary_["residual_q_over_p"] = m.residualStressRatio;
     summary_["residual_void_ratio"] = m.residualVoidRatio;
     summary_["critical_state_reached"] = cs.reached;
@@ -372,6 +429,7 @@ class RunSession {
                                                 {"d_eps_v", cs.endVolumetricRate},
                                                 {"d_e", cs.endVoidRatioRate}}
                                          : json(nullptr);
+    summary_["critical_state_window"] = criterion.csWindow;
     summary_["critical_state_criterion"] = fmt::format(
         "every trailing window of {} {} from critical_state_eps1 to the end has |d(q/p)/d eps| <= {}, |d eps_v/d eps| "
         "<= {} and |d e/d eps| <= {} (least-squares slopes, >= {} records); cs_* are the means from "
@@ -395,6 +453,7 @@ class RunSession {
     for (std::size_t i = 0; i < records.size(); ++i)
       if (std::abs(curves.eps1[i] - m.eps1AtPeak) < std::abs(curves.eps1[peak] - m.eps1AtPeak)) peak = i;
     summary_["micro_at_peak"] = microJson(records[peak]);
+    if (!simpleShear) summary_["boundary_contact_gap"] = stressGapJson(records, peak);
     summary_["micro_at_end"] = microJson(records.back());
     std::optional<double> residualMax;
     for (const auto& r : records)

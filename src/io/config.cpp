@@ -202,7 +202,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"test",
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
-        "loop_rest", "unload_to_q_fraction"}},
+        "loop_rest", "unload_to_q_fraction", "cs_window"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
@@ -531,7 +531,7 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "only used with test.type = \"simple-shear\"; " + here("test.type", type);
   if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
     return "only used with test.unload_reload_at (unload-reload loops)";
-  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed") && !shear)
+  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed" || key == "test.cs_window") && !shear)
     return "not used with test.type = \"isotropic\" (no shearing)";
   if (key == "solver.force_dt" && !c.solver.dt) return "only used with solver.dt (it allows a dt above the critical step)";
   if (key == "solver.damping" && c.solver.viscousDamping > 0.0)
@@ -568,7 +568,7 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
       // rate when it is run as an isotropic or simple-shear test): the other test's keys warn.
       static const std::set<std::string> testTypeKeys{
           "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
-          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed"};
+          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
           otherTestsKey) {
@@ -818,6 +818,14 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     }
   }
   c.test.finalShearStrain = t.number("final_shear_strain", c.test.finalShearStrain, 1e-4, 2.0, false, false, "must be in [1e-4, 2]");
+  if (const toml::node* n = t.raw("cs_window")) {
+    if (n->is_string() && n->value<std::string>().value() == "auto") {
+      c.test.csWindow.reset();
+    } else {
+      c.test.csWindow = t.number("cs_window", 0.0, 0.01, 1.0, false, false,
+                                 "must be \"auto\" or a strain in [0.01, 1] (eps1, or gamma in simple shear)");
+    }
+  }
   c.test.probeStrain = t.number("probe_strain", c.test.probeStrain, 0.0, 1e-3, false, false,
                                 "must be in [0, 1e-3] (axial strain of the small-strain probe; 0: no probe)");
   if (const toml::node* n = t.raw("unload_reload_at")) {
@@ -971,6 +979,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(test, "test", "loop_rest", c.test.loopRest);
   put(test, "test", "platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
   put(test, "test", "servo_max_speed", c.test.servoMaxSpeed);
+  if (c.test.csWindow) put(test, "test", "cs_window", *c.test.csWindow);
+  else put(test, "test", "cs_window", "auto");
   if (c.test.shearStrainRate) put(test, "test", "shear_strain_rate", *c.test.shearStrainRate);
   else put(test, "test", "shear_strain_rate", "auto");
   toml::table solver{{"viscous_damping", c.solver.viscousDamping},

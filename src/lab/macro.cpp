@@ -39,6 +39,8 @@ double slope(const std::vector<double>& x, const std::vector<double>& y, std::si
   return sxx > 0.0 ? sxy / sxx : 0.0;
 }
 
+double autoCsWindow(double finalStrain) { return std::max(0.05, 0.25 * finalStrain); }
+
 SteadyState steadyState(const std::vector<double>& eps, const std::vector<double>& eta,
                         const std::vector<double>& epsV, const std::vector<double>& e,
                         const std::vector<double>& p, const MacroSettings& s) {

@@ -43,6 +43,12 @@ struct MacroSettings {
   std::size_t csMinRecords = 5;
 };
 
+// The criterion's window for test.cs_window = "auto": a quarter of the test's final strain (eps1, or
+// gamma in simple shear), at least 0.05. A 20 % triaxial test gets 0.05; a simple-shear test to
+// gamma = 2 gets 0.5, long enough that the stress-ratio fluctuations of a 1000-2000 grain sample
+// (about +-0.1 in tau/sigma_n over gamma ~ 0.05-0.1) do not dominate the slopes.
+double autoCsWindow(double finalStrain);
+
 // The steady-state check of MacroSettings over the curves' strain `eps`: means and slopes of the
 // last window, and whether (and from where) every trailing window meets the thresholds.
 struct SteadyState {

@@ -1,6 +1,7 @@
 #include "lab/measurements.hpp"
 
 #include <cmath>
+#include <vector>
 
 #include "core/contact_view.hpp"
 
@@ -30,6 +31,24 @@ Mat3 contactStress(const Simulation& sim) {
     else s += c.force * c.branch.transpose();
   });
   return s / sim.volume();
+}
+
+Mat3 unbalancedStress(const Simulation& sim) {
+  if (sim.boundary == Boundary::Periodic) return Mat3::Zero();
+  const auto& x = sim.particles.position;
+  std::vector<Vec3> net(x.size(), Vec3::Zero());
+  forEachTouchingContact(sim, [&](const ContactView& c) {
+    if (c.wall) {
+      net[c.a] += c.force;  // the wall's force on a
+    } else {
+      net[c.b] += c.force;  // a's force on b
+      net[c.a] -= c.force;
+    }
+  });
+  const Vec3 centre = 0.5 * (sim.box.lowerCorner() + sim.box.upperCorner());
+  Mat3 u = Mat3::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) u -= net[i] * (x[i] - centre).transpose();
+  return u / sim.volume();
 }
 
 Vec3 boundaryStress(const Simulation& sim) {

@@ -15,6 +15,16 @@ double unbalancedForceRatio(const Simulation& sim);
 // full tensor: its skew part is a check (zero without contact moments at equilibrium).
 Mat3 contactStress(const Simulation& sim);
 
+// The wall box's stress that the contacts do not carry, compression positive:
+// U = -(1/V) sum_p F_p (x) (x_p - x_0), F_p the net contact force on particle p (walls included;
+// not damping or gravity), x_0 the box centre. Summing f (x) (x_c - x_0) over every contact of every
+// particle leaves only the wall contacts, so that at any instant, in equilibrium or not,
+//   wall stress = contactStress + U   (normal components; to the overlap / box length, since a wall
+// contact's point lies half an overlap behind the wall plane).
+// U vanishes at equilibrium; while the platens move it is the grains' inertia and the damping that
+// hold the net forces. Zero in a periodic cell, whose boundary stress is the contact stress.
+Mat3 unbalancedStress(const Simulation& sim);
+
 // The boundary's stresses (sigma_xx, sigma_yy, sigma_zz), compression positive [Pa]: the wall
 // stresses (mean of the two opposite walls) in a box, the symmetrised contact stress in a cell.
 Vec3 boundaryStress(const Simulation& sim);

@@ -40,6 +40,11 @@ struct Record {
   double q = 0.0, p = 0.0, e = 0.0, phiDeg = 0.0;
   double coordination = 0.0, unbalanced = 0.0, inertialNumber = 0.0;
   double sigma1Contact = 0.0, sigma2Contact = 0.0, sigma3Contact = 0.0;
+  // The boundary's stress at the record's step (sigma1..3 are means over the recording interval)
+  // and the part of it the contacts do not carry (lab::unbalancedStress, zero in a cell): the
+  // summary's boundary-contact stress gap is explained by these two (not written to timeseries.csv).
+  double sigma1Now = 0.0, sigma2Now = 0.0, sigma3Now = 0.0;
+  double sigma1Unbalanced = 0.0, sigma2Unbalanced = 0.0, sigma3Unbalanced = 0.0;
   double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
          dissipDamping = 0.0;

@@ -114,6 +114,9 @@ struct TestConfig {
   double b = 0.5;                     // true-triaxial: (sigma2 - sigma3)/(sigma1 - sigma3)
   std::optional<double> shearStrainRate;  // simple-shear [1/s]; nullopt = "auto"
   double finalShearStrain = 0.5;      // simple-shear: final gamma [-]
+  // Window of the steady-state (critical-state) criterion (lab/macro.hpp) in the test's strain;
+  // nullopt = "auto": a quarter of the final strain, at least 0.05 (lab::autoCsWindow).
+  std::optional<double> csWindow;
   // Small-strain probe after consolidation (lab/moduli.hpp): axial strain increment with the
   // lateral stress held; 0: no probe (E0, nu0 null).
   double probeStrain = 1e-6;

@@ -83,6 +83,14 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.sigma1Contact = sc(2, 2);
   r.sigma2Contact = sc(0, 0);
   r.sigma3Contact = sc(1, 1);
+  const Vec3 now = boundaryStress(sim_);
+  r.sigma1Now = now[2];
+  r.sigma2Now = now[0];
+  r.sigma3Now = now[1];
+  const Mat3 su = unbalancedStress(sim_);
+  r.sigma1Unbalanced = su(2, 2);
+  r.sigma2Unbalanced = su(0, 0);
+  r.sigma3Unbalanced = su(1, 1);
   if (sim_.boundary == Boundary::Periodic) {
     r.eps1Log = -std::log(len[2] / h0);
     r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);

@@ -156,6 +156,44 @@ TEST(Macro, NoisySteadyCurvesReachItAndShortTestsAreNotEvaluated) {
   EXPECT_FALSE(none.reached);
 }
 
+TEST(Macro, TheAutoWindowIsAQuarterOfTheTestAtLeast5Percent) {
+  EXPECT_DOUBLE_EQ(lab::autoCsWindow(0.20), 0.05);  // the 20 % triaxial tests keep the 0.05 window
+  EXPECT_DOUBLE_EQ(lab::autoCsWindow(0.15), 0.05);
+  EXPECT_DOUBLE_EQ(lab::autoCsWindow(2.0), 0.5);
+  EXPECT_DOUBLE_EQ(lab::autoCsWindow(0.5), 0.125);
+}
+
+// Simple shear to gamma = 2 of a small sample: tau/sigma_n fluctuates by +-0.1 over gamma ~ 0.07
+// (stick-slip of force chains) about a flat mean. A 0.05 window sees the fluctuation's slope
+// (up to 0.1 * 2 pi / 0.07 ~ 9), not a trend; the auto window of a quarter of the test averages it.
+// A sample whose void ratio still rises by 0.1 per unit gamma under the same noise is refused by
+// either window.
+TEST(Macro, FluctuatingSteadyShearNeedsTheLongWindowAndAStillDilatingOneFailsBoth) {
+  std::vector<double> g, eta, ev, e, p, eRising, evRising;
+  for (int i = 0; i <= 2000; ++i) {
+    const double x = 1e-3 * i;
+    const double wobble = 0.1 * std::sin(2 * kPi * x / 0.07) + 0.03 * std::sin(2 * kPi * x / 0.023 + 1.0);
+    g.push_back(x);
+    eta.push_back(x < 0.3 ? 0.65 + 0.5 * (0.3 - x) : 0.65 + wobble);
+    ev.push_back(x < 0.3 ? -0.1 * x : -0.03 + 0.002 * std::sin(2 * kPi * x / 0.11));
+    e.push_back(0.60 - 1.6 * ev.back());
+    evRising.push_back(-0.1 * x + 0.002 * std::sin(2 * kPi * x / 0.11));
+    eRising.push_back(0.60 - 1.6 * evRising.back());
+    p.push_back(200e3);
+  }
+  lab::MacroSettings shortWindow;
+  EXPECT_FALSE(lab::steadyState(g, eta, ev, e, p, shortWindow).reached);
+  lab::MacroSettings autoWindow;
+  autoWindow.csWindow = lab::autoCsWindow(2.0);
+  const lab::SteadyState cs = lab::steadyState(g, eta, ev, e, p, autoWindow);
+  ASSERT_TRUE(cs.reached);
+  EXPECT_NEAR(cs.stressRatio, 0.65, 0.01);
+  EXPECT_NEAR(cs.voidRatio, 0.60 + 1.6 * 0.03, 0.002);
+  EXPECT_LT(cs.reachedAt, 1.0);
+  EXPECT_FALSE(lab::steadyState(g, eta, evRising, eRising, p, autoWindow).reached);
+  EXPECT_FALSE(lab::steadyState(g, eta, evRising, eRising, p, shortWindow).reached);
+}
+
 TEST(Macro, StressDilatancyDataAgainstTheSyntheticCurves) {
   // eps_v = 0.0025 - 0.5 (eps1 - 0.01) on 1 % < eps1 < 10 %: D = 0.5 wherever the +-0.5 % window
   // lies inside that branch; R = sigma1/sigma3 and q/p from the stresses of each record.

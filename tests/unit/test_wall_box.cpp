@@ -116,3 +116,35 @@ TEST_F(WallBoxSample, DeviatoricContactStressEqualsWallStress) {
   EXPECT_NEAR(last.sigma1Contact / last.sigma1, 1.0, 0.05);
   EXPECT_NEAR(last.eps1, 0.03, 0.001);
 }
+
+// Out of equilibrium the wall stress and the contact stress differ, and by exactly the stress of the
+// grains' net contact forces (lab::unbalancedStress): the platens are driven 20x faster than the
+// test's rate, so that the net forces are large, and at every one of 30 steps each normal component
+// satisfies wall = contact + unbalanced to 0.2 % of p (a contact point lies half an overlap behind
+// the wall plane), while the gap itself is several times larger (the check is not vacuous). A wrong
+// sign, origin or arm in either sum breaks it.
+TEST_F(WallBoxSample, WallStressIsContactStressPlusTheNetForcesStressOutOfEquilibrium) {
+  lab::Laboratory lab = *lab_;
+  lab.shear();
+  Simulation& sim = lab.simulation();
+  const double speed = 20.0 * std::abs(sim.box.upper(2).velocity) + 1e-4;
+  sim.box.lower(2).velocity = speed;
+  sim.box.upper(2).velocity = -speed;
+  double largestGap = 0.0;
+  for (int k = 0; k < 30; ++k) {
+    sim.step();
+    const Vec3 walls = lab::boundaryStress(sim);
+    const Mat3 contacts = lab::contactStress(sim);
+    const Mat3 unbalanced = lab::unbalancedStress(sim);
+    const double p = walls.sum() / 3.0;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(walls[a], contacts(a, a) + unbalanced(a, a), 2e-3 * p) << "step " << k << " axis " << a;
+      largestGap = std::max(largestGap, std::abs(walls[a] - contacts(a, a)) / p);
+    }
+  }
+  EXPECT_GT(largestGap, 0.01) << "the sample stayed in equilibrium: the identity was not tested";
+  // In a periodic cell the boundary stress is the contact stress: nothing is left over.
+  Simulation cell;
+  cell.boundary = Boundary::Periodic;
+  EXPECT_EQ(lab::unbalancedStress(cell), Mat3::Zero());
+}
