@@ -5,10 +5,13 @@ Usage: ouadfel_series.py OUT [--grainlab BIN] [--jobs 2] [--particles 343] [--do
 
 For each shape (prolate spheroids b/a = 0.7 of preset ouadfel-spheroids, and spheres of the same
 volume prepared the same way), the grown sample is made and tested at p = 100 kPa (kappa = 25);
-its packing file, unloaded by the cell's servo with friction on, gives the samples at 70, 50, 30
-and 10 kPa (kappa = 36, 50, 83, 250 with the same Kn), each tested at constant p to 20.5 % at an
+its packing file, unloaded by the cell's servo, gives the samples at 70, 50, 30 and 10 kPa
+(--unloading frictionless, the default, is [O]'s protocol: the packing goes to the lower pressure
+with friction 0, sample.packing_friction_deg = 0, and the test's friction is restored before the
+test; --unloading frictional keeps the friction on, the series published before 2026-12-02) (kappa = 36, 50, 83, 250 with the same Kn), each tested at constant p to 20.5 % at an
 inertial number of 1e-4. Every run is one `grainlab run` (argument vector, no shell) into
-OUT/<shape>-<p>kPa. With --doc, writes the tables and plots of results/ouadfel.md there.
+OUT/<shape>-<p>kPa. With --doc, writes the tables and plots of results/ouadfel.md there (into ouadfel/ for the
+frictional unloading, ouadfel-frictionless/ for [O]'s).
 """
 import argparse
 import csv
@@ -52,6 +55,7 @@ def series(args):
             packing = os.path.join(bases[shape], "packing.txt")
             for p in PRESSURES_KPA[1:]:
                 sets = ["--set", f'sample.packing="{packing}"', "--set", f"test.confining_pressure={p * 1e3!r}",
+                        *(["--set", "sample.packing_friction_deg=0.0"] if args.unloading == "frictionless" else []),
                         "--set", f"test.axial_strain_rate={rate(p * 1e3)!r}"]
                 jobs.append(pool.submit(run, args, f"{shape}-{p}kPa", sets))
         for j in jobs:
@@ -75,7 +79,7 @@ def document(args):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    pictures = os.path.join(args.doc, "ouadfel")
+    pictures = os.path.join(args.doc, "ouadfel" if args.unloading == "frictional" else "ouadfel-frictionless")
     os.makedirs(pictures, exist_ok=True)
     table = []
     fig, axes = plt.subplots(2, 3, figsize=(15, 8.5))
@@ -95,7 +99,8 @@ def document(args):
             ax.set_xlabel("axial strain eps1 [%]")
             ax.grid(alpha=0.3)
         row_axes[0].legend(fontsize=8)
-    fig.suptitle(f"[O] constant-p series, {args.particles} grains, periodic cell, mu = 0.5, Ks = Kn")
+    fig.suptitle(f"[O] constant-p series, {args.particles} grains, periodic cell, mu = 0.5, Ks = Kn, "
+                 f"{args.unloading} unloading")
     fig.tight_layout()
     fig.savefig(os.path.join(pictures, "series.png"), dpi=100)
     plt.close(fig)
@@ -141,6 +146,8 @@ def main():
     ap.add_argument("--grainlab", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "grainlab"))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--particles", type=int, default=343)
+    ap.add_argument("--unloading", choices=("frictionless", "frictional"), default="frictionless",
+                    help="how the 100 kPa packing goes to the lower pressures ([O]: frictionless)")
     ap.add_argument("--doc", help="write results/ouadfel tables and plots into this folder")
     args = ap.parse_args()
     args.grainlab = os.path.abspath(args.grainlab)

@@ -761,6 +761,9 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       }
       // A packing file is taken as it is: no preparation friction was used.
       s["prep_friction_deg"] = prep.prepFrictionDeg ? json(*prep.prepFrictionDeg) : json(nullptr);
+      if (packed.has_value())
+        s["packing_friction_deg"] =
+            config.sample.packingFrictionDeg ? json(*config.sample.packingFrictionDeg) : json(nullptr);
       s["preparation_method"] = config.sample.packing.empty() ? config.sample.method : "packing file";
       json search = json::array();
       for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});

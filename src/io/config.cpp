@@ -195,7 +195,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"sample",
        {"n_particles", "grading", "density", "e0", "seed", "prep_friction_deg", "e0_tolerance", "initial_void_ratio",
         "packing", "prep_stiffness_factor", "prep_ramp_steps", "prep_damping", "method", "growth_rate",
-        "lattice_jitter", "shape"}},
+        "lattice_jitter", "shape", "packing_friction_deg"}},
       {"contact",
        {"model", "young", "poisson", "friction_deg", "beta", "eta", "wall_friction_deg", "moment_limit", "kn",
         "rolling_friction", "sphericity"}},
@@ -500,6 +500,8 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
       "sample.growth_rate",  "sample.lattice_jitter", "sample.shape"};
   if (packing && (preparation.count(key) || key.rfind("sample.shape.", 0) == 0))
     return "not used with sample.packing (a packing file is taken as it is: no preparation)";
+  if (!packing && key == "sample.packing_friction_deg")
+    return "only used with sample.packing (the friction while a given packing is brought to the test's pressure)";
   if (!packing && key == "sample.grading" && c.sample.grading.type == "packing")
     return "{ type = \"packing\" } needs sample.packing";
   if (key == "sample.growth_rate" && method != "growth")
@@ -711,6 +713,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.sample.packing = resolvePath(s.string("packing", c.sample.packing, {}), baseDir);
   if (inputFilesMustExist && !c.sample.packing.empty() && !pathExists(c.sample.packing))
     fail("sample.packing", quotedPath(c.sample.packing), notFound(c.sample.packing));
+  if (s.raw("packing_friction_deg"))
+    c.sample.packingFrictionDeg = s.number("packing_friction_deg", 0.0, 0.0, 90.0, false, true,
+                                           "must be an angle in [0, 90) [deg]");
   c.sample.prepStiffnessFactor = s.number("prep_stiffness_factor", c.sample.prepStiffnessFactor, 0.0, 1.0, true, false,
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
@@ -944,6 +949,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(sample, "sample", "growth_rate", c.sample.growthRate);
   put(sample, "sample", "lattice_jitter", c.sample.latticeJitter);
   put(sample, "sample", "shape", shape);
+  if (c.sample.packingFrictionDeg) put(sample, "sample", "packing_friction_deg", *c.sample.packingFrictionDeg);
   if (c.sample.prepFrictionDeg) put(sample, "sample", "prep_friction_deg", *c.sample.prepFrictionDeg);
   else put(sample, "sample", "prep_friction_deg", "auto");
   toml::table contact{{"model", c.contact.model},

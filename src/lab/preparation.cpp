@@ -259,7 +259,17 @@ PreparationResult Laboratory::adoptPacking(Simulation packed) {
   result.grading = gradingStats(diameters);
   d50_ = result.grading.d50;
   configureSolver(config_, sim_);
-  result.steps = consolidate(config_.test.confiningPressure, "equilibrium of the given packing");
+  result.steps = 0;
+  if (config_.sample.packingFrictionDeg) {
+    // [O]'s unloading to a lower pressure: the packing goes to the test's pressure at this friction
+    // (0: grains slide freely, as in [O]), then the test's friction is restored.
+    const double friction = sim_.model.tanFriction;
+    sim_.model.tanFriction = std::tan(degToRad(*config_.sample.packingFrictionDeg));
+    result.steps += consolidate(config_.test.confiningPressure,
+                                fmt::format("the given packing to p at friction {} deg", *config_.sample.packingFrictionDeg));
+    sim_.model.tanFriction = friction;
+  }
+  result.steps += consolidate(config_.test.confiningPressure, "equilibrium of the given packing");
   result.e0 = voidRatio(sim_);
   records_.reset(sim_);
   result.state = equilibriumState();

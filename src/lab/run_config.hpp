@@ -59,6 +59,10 @@ struct SampleConfig {
   double e0Tolerance = 0.01;
   double initialVoidRatio = 2.0;  // of the loose random placement before compaction
   std::string packing;            // start from this packing file instead of preparing a sample
+  // With a packing: the friction [deg] while the packing is brought to test.confining_pressure
+  // (then friction is restored and the sample re-equilibrated); nullopt: contact.friction_deg
+  // throughout. [O]'s gradual frictionless unloading to the lower pressures is 0.
+  std::optional<double> packingFrictionDeg;
   double prepStiffnessFactor = 0.01;  // contact stiffness during compaction, as a fraction of Ec
   double prepDamping = 0.3;           // local damping during compaction
   long prepRampSteps = 20000;         // steps of the geometric ramp from the soft to the full Ec
