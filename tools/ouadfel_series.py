@@ -23,7 +23,7 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 
 PRESSURES_KPA = [100, 70, 50, 30, 10]
-SHAPES = {"spheroids": [], "spheres": ["--set", 'sample.shape.type="sphere"']}
+SHAPES = {"spheroids": [], "spheres": ["--set", 'sample.shape={ type = "sphere" }']}
 DENSITY, DIAMETER, KN, INERTIAL = 2600.0, 2e-3, 5000.0, 1e-4
 
 
