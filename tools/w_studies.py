@@ -5,6 +5,7 @@
     /usr/bin/python3 tools/w_studies.py report [--runs DIR] [--docs docs/results]
     /usr/bin/python3 tools/w_studies.py size   [--size-runs runs/w-size] [--sizes 2000,8000]
     /usr/bin/python3 tools/w_studies.py compare --runs DIR_A --runs-b DIR_B [--out FILE]
+    /usr/bin/python3 tools/w_studies.py replicates [--seeds 3] [--runs runs/w-studies-seeds] [--set K=V]
 
 `run` shears the base case once (2 threads), then one `grainlab sweep` per study over the values
 that differ from the base (1 thread per case, --jobs cases at a time); a study whose sweep.csv
@@ -13,6 +14,13 @@ stopped. `report` writes docs/results/w-parameter-studies-table.md (one row per 
 included in every study) and overlay plots docs/results/w-studies/<study>_q.png and _epsv.png.
 `size` runs the base case alone on 2 threads at each number of spheres (skipping those done) and
 writes docs/results/w-size-table.md and docs/results/w-studies/size_q.png, size_epsv.png.
+`replicates` runs every case (base included) with --seeds N replicate samples (default 3; one
+`grainlab sweep --seeds` per study, cases already completed are kept) into --runs (default
+runs/w-studies-seeds) and writes docs/results/w-parameter-studies-seeds-table.md: mean ± standard
+deviation over the seeds of each case, [W]'s published base-case values beside the base, and for
+every non-base case whether its difference from the base exceeds twice the larger of the two
+standard deviations (a trend) or not. --set KEY=VALUE applies to every case (e.g. a smoke test
+with few grains).
 `compare` puts two complete runs of the studies (e.g. two code versions or seeds) side by side,
 case by case, with the mean absolute difference of each quantity: the scatter of a single run.
 """
@@ -264,9 +272,113 @@ def compare(opt):
     write_table(opt.out, lines)
 
 
+# [W]'s values for the base case as its text states them (quoted by the project's review, issue 23);
+# the other cases' published values are not at hand as numbers.
+W_BASE = {"phi_peak_deg": 40.0, "phi_res_deg": 29.0, "psi_max_deg": 16.0, "E_MPa": 95.0}
+REPLICATE_COLUMNS = [("e0", "e0", 3), ("φp [°]", "phi_peak_deg", 1), ("φres [°]", "phi_res_deg", 1),
+                     ("ψmax sin [°]", "psi_max_deg", 1), ("ψmax tan [°]", "psi_max_tan_deg", 1),
+                     ("E0 [MPa]", "E_MPa", 0), ("E50 [MPa]", "E50_MPa", 0), ("e end", "end_void_ratio", 3)]
+
+
+def replicate_cases(opt):
+    """(study, key, value, label, folder of the sweep, row-selector) for every case, base first."""
+    out = [("base", None, None, "base", os.path.join(opt.runs, "base"), lambda r: True)]
+    for study, key, values, _ in STUDIES:
+        for v in values:
+            if is_base(key, v):
+                continue
+            if v == "densest":
+                out.append((study, key, v, "densest", os.path.join(opt.runs, "e0-densest"), lambda r: True))
+            else:
+                out.append((study, key, v, show(key, v), os.path.join(opt.runs, study),
+                            lambda r, key=key, v=v: abs(float(r[key]) - float(v)) <= 1e-9 * max(1.0, abs(float(v)))))
+    return out
+
+
+def replicates(opt):
+    sets = [a for s in opt.set for a in ("--set", s)]
+    common = ["--seeds", str(opt.seeds), "--jobs", str(opt.jobs), "--threads", "1", "--quiet", *sets]
+    sh([opt.exe, "sweep", "preset:w-base", *common, "--out", os.path.join(opt.runs, "base")])
+    for study, key, values, _ in STUDIES:
+        numeric = [v for v in values if v != "densest" and not is_base(key, v)]
+        if numeric:
+            sh([opt.exe, "sweep", "preset:w-base", "--vary", f"{key}=" + ",".join(f"{v:g}" for v in numeric), *common,
+                "--out", os.path.join(opt.runs, study)])
+        if "densest" in values:
+            sh([opt.exe, "sweep", "preset:w-base", "--vary", "sample.prep_friction_deg=0", *common,
+                "--out", os.path.join(opt.runs, "e0-densest")])
+    replicates_report(opt)
+
+
+def stats_rows(folder, select):
+    path = os.path.join(folder, "sweep-stats.csv")
+    if not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        rows = [r for r in csv.DictReader(f) if select(r)]
+    return rows[0] if rows else None
+
+
+def replicates_report(opt):
+    def cell(row, k, digits):
+        n = int(row[k + "_n"]) if row.get(k + "_n") else 0
+        if n == 0:
+            return "null"
+        mean = float(row[k + "_mean"])
+        if n >= 3:
+            return f"{mean:.{digits}f} ± {float(row[k + '_std']):.{digits}f}"
+        if n == 2:
+            return f"[{float(row[k + '_min']):.{digits}f}, {float(row[k + '_max']):.{digits}f}]"
+        return f"{mean:.{digits}f}"
+
+    lines = ["| study | value | seeds | " + " | ".join(c[0] for c in REPLICATE_COLUMNS) +
+             " | critical state | trend against the base (> 2 std) |",
+             "|---|---|---:|" + "---:|" * len(REPLICATE_COLUMNS) + "---|---|"]
+    base = stats_rows(os.path.join(opt.runs, "base"), lambda r: True)
+    for study, key, value, label, folder, select in replicate_cases(opt):
+        row = stats_rows(folder, select)
+        if row is None:
+            lines.append(f"| {study} | {label} | not run |" + " |" * (len(REPLICATE_COLUMNS) + 2))
+            continue
+        cells = [cell(row, k, d) for _, k, d in REPLICATE_COLUMNS]
+        reached = row.get("critical_state_reached_mean")
+        n = int(row.get("critical_state_reached_n") or 0)
+        cs = f"{round(float(reached) * n)} of {n}" if reached else "null"
+        trends, compared = [], 0
+        if study != "base" and base is not None:
+            for name, k, digits in REPLICATE_COLUMNS[1:5]:
+                # A standard deviation needs two seeds on both sides; otherwise nothing is claimed.
+                if not row.get(k + "_std") or not base.get(k + "_std"):
+                    continue
+                compared += 1
+                d = float(row[k + "_mean"]) - float(base[k + "_mean"])
+                bound = 2 * max(float(row[k + "_std"]), float(base[k + "_std"]))
+                if abs(d) > bound:
+                    trends.append(f"{name.split(' ')[0]} {d:+.{digits}f}")
+            trend = (", ".join(trends) if trends else "none beyond the scatter") if compared else "not measurable"
+        else:
+            trend = "–"
+        lines.append(f"| {study} | {label} | {row['seeds_completed']} of {row['seeds']} | " + " | ".join(cells) +
+                     f" | {cs} | {trend} |")
+        if study == "base":
+            lines.append("| [W] (2009) | base | – | 0.60 | " + " | ".join(
+                f"{W_BASE[k]:g}" if k in W_BASE else "–" for _, k, _ in REPLICATE_COLUMNS[1:]) + " | – | – |")
+    header = (f"Over {opt.seeds} seeds per case (runs in {opt.runs}): mean ± sample standard deviation (the range "
+              "for 2 seeds); a trend is a difference from the base beyond twice the larger standard deviation. "
+              "[W]'s E is its modulus E0/σc label's, set beside our E0.\n\n")
+    os.makedirs(opt.docs, exist_ok=True)
+    out = os.path.join(opt.docs, "w-parameter-studies-seeds-table.md")
+    with open(out + ".tmp", "w") as f:
+        f.write(header + "\n".join(lines) + "\n")
+    os.replace(out + ".tmp", out)
+    print("\n".join(lines))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("action", choices=["run", "report", "size", "compare"])
+    ap.add_argument("action", choices=["run", "report", "size", "compare", "replicates", "replicates-report"])
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--set", action="append", default=[], help="KEY=VALUE for every case (replicates)")
     ap.add_argument("--runs-b", default="runs/w-studies-v2")
     ap.add_argument("--out", default="docs/results/w-parameter-studies-compare.md")
     ap.add_argument("--size-runs", default="runs/w-size")
@@ -281,6 +393,11 @@ def main():
         return 0
     if opt.action == "compare":
         compare(opt)
+        return 0
+    if opt.action in ("replicates", "replicates-report"):
+        if opt.runs == "runs/w-studies":
+            opt.runs = "runs/w-studies-seeds"
+        replicates(opt) if opt.action == "replicates" else replicates_report(opt)
         return 0
     if opt.action == "run":
         run(opt)
