@@ -218,6 +218,24 @@ def test_bad_packings_fail_check(base, tmp_path, rows, words):
     refused(run("check", str(cfg)), "sample.packing", *words)
 
 
+@pytest.mark.parametrize("overlap,accepted", [(0.12, True), (0.45, True), (0.6, False)])
+def test_soft_contact_overlaps_are_accepted_deep_ones_refused(tmp_path, grainlab, overlap, accepted):
+    """A packing of soft contacts in equilibrium overlaps by more than a tenth of a radius ([O]'s
+    kappa = 25 grown spheres: 0.12, which grainlab once refused in its own packing file); beyond
+    half the smaller radius it is refused, naming both grains."""
+    r = 0.002
+    rows = [(r, 0.005, 0.005, 0.005), (r, 0.005 + 2 * r - overlap * r, 0.005, 0.005)]
+    pk = tmp_path / "p.txt"
+    pk.write_text(packing_text(rows))
+    cfg = tmp_path / "pk.toml"
+    cfg.write_text(f'[sample]\npacking = "{pk}"\n[test]\nfinal_axial_strain = 0.01\n[solver]\nthreads = 1\n'
+                   f'[output]\ndir = "{tmp_path / "out"}"\nplots = false\n')
+    if accepted:
+        grainlab("check", str(cfg), check=0)
+    else:
+        refused(run("check", str(cfg)), "sample.packing", "id 0 and id 1", "overlap", "0.5 of the smaller radius")
+
+
 def test_packing_overlap_check_is_linear(tmp_path, grainlab):
     """20 000 grains on a lattice touching their neighbours (overlap 1 %): accepted quickly."""
     n, r = 27, 0.001
