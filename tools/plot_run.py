@@ -139,7 +139,108 @@ def main(directory):
         fig.suptitle(title, fontsize=10)
         fig.tight_layout()
         save(fig, os.path.join(out, "energy.png"))
+    laboratory_plots(data, summary, out, title)
     return 0
+
+
+def laboratory_plots(data, summary, out, title):
+    """The undrained, oedometer and cyclic tests' own plots (docs/laboratory.md): the effective
+    stress path q-p' and u against eps1 (undrained), e-log sigma_v and sigma_h against sigma_v
+    (oedometer), q-p', q-eps1 and u/p0 against the cycles (cyclic triaxial)."""
+    p0 = summary.get("confining_pressure") or (data["p"][0] if data.get("p") else 1.0)
+    test = summary.get("test", "")
+    kpa = lambda key: [v / 1e3 for v in data[key]]
+    if test == "oedometer" and "load_direction" in data:
+        fig, (ax, axk) = plt.subplots(1, 2, figsize=(11, 4.2))
+        load = [d > 0 for d in data["load_direction"]]
+        for want, label in ((True, "loading"), (False, "unloading")):
+            x = [v / 1e3 for v, l in zip(data["sigma1"], load) if l == want]
+            e = [v for v, l in zip(data["e"], load) if l == want]
+            ax.semilogx(x, e, ".-", ms=2, lw=1, label=label)
+            sh = [0.5 * (a + b) / 1e3 for a, b, l in zip(data["sigma2"], data["sigma3"], load) if l == want]
+            axk.plot(x, sh, ".-", ms=2, lw=1, label=label)
+        ax.set_xlabel("axial stress sigma_v [kPa]")
+        ax.set_ylabel("void ratio e")
+        ax.set_title("Cc = {}, Cs = {}".format(fmt(summary.get("Cc")), fmt(summary.get("Cs"))), fontsize=9)
+        axk.set_xlabel("axial stress sigma_v [kPa]")
+        axk.set_ylabel("lateral stress sigma_h [kPa]")
+        axk.set_title("K0 = {} (loading), {} (end of unloading)".format(fmt(summary.get("K0")),
+                                                                        fmt(summary.get("K0_unloading"))), fontsize=9)
+        for a in (ax, axk):
+            a.grid(alpha=0.3)
+            a.legend(fontsize=8)
+        fig.suptitle(title + " - oedometer", fontsize=10)
+        fig.tight_layout()
+        save(fig, os.path.join(out, "oedometer.png"))
+        return
+    if "u" not in data and test != "cyclic-triaxial":
+        return
+    cyclic = test == "cyclic-triaxial"
+    panels = 3 if cyclic else 2
+    fig, axes = plt.subplots(1, panels, figsize=(5.3 * panels, 4.2))
+    ax = axes[0]
+    ax.plot(kpa("p"), kpa("q"), lw=1.1)
+    ax.set_xlabel("mean effective stress p' [kPa]")
+    ax.set_ylabel("deviator q [kPa]")
+    ax.set_xlim(left=0.0)
+    ax.grid(alpha=0.3)
+    if cyclic:
+        axes[1].plot([100.0 * v for v in data["eps1"]], kpa("q"), lw=1.0)
+        axes[1].set_xlabel("axial strain eps1 [%]")
+        axes[1].set_ylabel("deviator q [kPa]")
+        axes[1].grid(alpha=0.3)
+        axr = axes[2]
+        # Cycles as a continuous axis: the records at the reversals (where `cycle` steps by a half)
+        # are exact, the others interpolated in step between them.
+        knots_s, knots_c = [data["step"][0]], [0.0]
+        for s_, c_, prev in zip(data["step"][1:], data["cycle"][1:], data["cycle"]):
+            if c_ != prev:
+                knots_s.append(s_)
+                knots_c.append(c_)
+        last_s = data["step"][-1]
+        if knots_s[-1] != last_s:
+            # The records after the last reversal belong to the half cycle the test ended in.
+            knots_s.append(last_s)
+            knots_c.append(knots_c[-1] + 0.5)
+        cycles = [interp(s_, knots_s, knots_c) for s_ in data["step"]]
+        if "u" in data:
+            axr.plot(cycles, [1.0 - v / p0 for v in data["p"]], lw=1.0, label="ru = 1 - p'/p0")
+            axr.plot(cycles, [v / p0 for v in data["u"]], lw=0.6, alpha=0.6, label="u/p0")
+            axr.set_ylabel("excess pore-pressure ratio")
+            axr.legend(fontsize=8)
+        else:
+            axr.plot(cycles, [100.0 * v for v in data["eps1"]], lw=1.0)
+            axr.set_ylabel("axial strain eps1 [%]")
+        axr.set_xlabel("cycles")
+        axr.grid(alpha=0.3)
+        n = summary.get("n_cycles_to_liquefaction")
+        axes[0].set_title("CSR = {}, N_liq = {}".format(fmt(summary.get("csr")), fmt(n)), fontsize=9)
+        name = "cyclic.png"
+    else:
+        axu = axes[1]
+        axu.plot([100.0 * v for v in data["eps1"]], kpa("u"), lw=1.1)
+        axu.axhline(0.0, color="k", lw=0.5)
+        axu.set_xlabel("axial strain eps1 [%]")
+        axu.set_ylabel("excess pore pressure u [kPa]")
+        axu.grid(alpha=0.3)
+        axes[0].set_title("p'_min = {} kPa, liquefied: {}".format(fmt((summary.get("p_min") or 0) / 1e3),
+                                                                    summary.get("liquefied")), fontsize=9)
+        name = "undrained.png"
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    save(fig, os.path.join(out, name))
+
+
+def interp(x, xs, ys):
+    for i in range(1, len(xs)):
+        if x <= xs[i]:
+            f = (x - xs[i - 1]) / (xs[i] - xs[i - 1]) if xs[i] > xs[i - 1] else 1.0
+            return ys[i - 1] + f * (ys[i] - ys[i - 1])
+    return ys[-1]
+
+
+def fmt(v):
+    return "null" if v is None else "{:.3g}".format(v)
 
 
 if __name__ == "__main__":

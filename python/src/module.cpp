@@ -281,18 +281,12 @@ class PySimulation {
     if (PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1) != 0) throw py::error_already_set();
   }
 
-  // The state the strains are measured from: the current one.
-  void resetReference() {
-    lengths0_ = lab::sampleLengths(sim());
-    volume0_ = sim().volume();
-    if (sim().boundary == Boundary::Periodic) sim().cell.referenceLength = sim().cell.h.diagonal();
-  }
+  // The state the strains are measured from: the current one (lab/boundary_control.hpp).
+  void resetReference() { boundary().setReference(); }
   // Engineering strains of the sample's lengths since the reference, compression positive.
-  Eigen::Vector3d strain() const {
-    const Vec3 l = lab::sampleLengths(sim());
-    return {1.0 - l[0] / lengths0_[0], 1.0 - l[1] / lengths0_[1], 1.0 - l[2] / lengths0_[2]};
-  }
-  double volumetricStrain() const { return 1.0 - sim().volume() / volume0_; }
+  Eigen::Vector3d strain() const { return boundary().strain(); }
+  double volumetricStrain() const { return boundary().volumetricStrain(); }
+  lab::BoundaryControl& boundary() const { return lab_->boundary(); }
 
   static void checkAxis(int axis) {
     if (axis < 0 || axis > 2) throw py::value_error(fmt::format("axis = {}; allowed: 0 (x), 1 (y), 2 (z)", axis));
@@ -309,52 +303,34 @@ class PySimulation {
     if (stress < 0.0) throw py::value_error(fmt::format("stress = {}; allowed: >= 0 (compression positive)", stress));
     if (side && *side != 0 && *side != 1)
       throw py::value_error(fmt::format("side = {}; allowed: 0 (lower wall), 1 (upper wall) or None (both)", *side));
-    if (sim().boundary == Boundary::Periodic) {
-      if (side) throw py::value_error("side: a periodic cell has no walls; allowed: None");
-      sim().cell.control[axis] = CellControl::Stress;
-      sim().cell.targetStress[axis] = stress;
-      return;
-    }
-    for (int k = 0; k < 2; ++k) {
-      if (side && k != *side) continue;
-      Wall& w = sim().box.walls[WallBox::index(axis, k)];
-      w.control = WallControl::Stress;
-      w.targetStress = stress;
-    }
+    if (side && boundary().periodic()) throw py::value_error("side: a periodic cell has no walls; allowed: None");
+    if (side) boundary().holdFaceStress(axis, *side, stress);
+    else boundary().holdStress(axis, stress);
   }
   // Simple shear of the cell: L_xz = rate (dx/dt = rate z) [1/s]; 0 stops it.
   void setShearRate(double rate) {
     checkFinite(rate, "rate");
-    if (sim().boundary != Boundary::Periodic)
+    if (!boundary().periodic())
       throw py::value_error("set_shear_rate: only a periodic cell shears (test.boundary = \"periodic\")");
-    holdCellShape();
-    sim().cell.shearRate = rate;
-  }
-  // A strained cell keeps its principal axes (no shear servo), as the CLI's shearing tests do
-  // (lab/shear.cpp); hold_isotropic() gives the shear stresses back to their servo.
-  void holdCellShape() {
-    for (int k = 0; k < 3; ++k) {
-      if (sim().cell.shearControl[k] == CellControl::Stress) sim().cell.shearServoIntegral[k] = 0.0;
-      sim().cell.shearControl[k] = CellControl::StrainRate;
-    }
+    boundary().holdShape();
+    boundary().imposeShearRate(rate);
   }
   // Strain control of one axis at an engineering rate of the reference length [1/s], compression
   // positive: the walls move towards each other at rate L0/2 each (as the CLI's platens), or the
-  // cell's H_ii changes at -rate H0_ii.
+  // cell's H_ii changes at -rate H0_ii. A strained cell keeps its principal axes (no shear servo),
+  // as the CLI's shearing tests do; hold_isotropic() gives the shear stresses back to their servo.
   void setStrainRate(int axis, double rate) {
     checkAxis(axis);
     checkFinite(rate, "rate");
-    if (sim().boundary == Boundary::Periodic) {
-      holdCellShape();
-      sim().cell.control[axis] = CellControl::StrainRate;
-      sim().cell.strainRate[axis] = rate;
-      return;
-    }
-    const double speed = 0.5 * rate * lengths0_[axis];
-    sim().box.lower(axis).control = WallControl::Velocity;
-    sim().box.lower(axis).velocity = speed;
-    sim().box.upper(axis).control = WallControl::Velocity;
-    sim().box.upper(axis).velocity = -speed;
+    boundary().holdShape();
+    boundary().imposeStrainRate(axis, rate);
+  }
+  // Constant volume taken up by this axis (an undrained test on a dry sample): the volume at the
+  // call is kept.
+  void setConstantVolume(int axis) {
+    checkAxis(axis);
+    boundary().holdShape();
+    boundary().constantVolume(axis);
   }
 
   double d50() const { return prep_.grading.d50; }
@@ -364,8 +340,6 @@ class PySimulation {
   std::unique_ptr<PythonObserver> observer_;  // the laboratory's progress reports (preparation)
   std::unique_ptr<lab::Laboratory> lab_;
   lab::PreparationResult prep_;
-  Vec3 lengths0_ = Vec3::Ones();
-  double volume0_ = 1.0;
   mutable std::atomic<bool> busy_{false};
   bool warnedFork_ = false;
 };
@@ -512,6 +486,8 @@ PYBIND11_MODULE(_grainlab, m) {
       .def("set_stress", &PySimulation::setStress, py::arg("axis"), py::arg("stress"), py::arg("side") = py::none())
       .def("set_shear_rate", &PySimulation::setShearRate, py::arg("rate"))
       .def("set_strain_rate", &PySimulation::setStrainRate, py::arg("axis"), py::arg("rate"))
+      .def("set_constant_volume", &PySimulation::setConstantVolume, py::arg("axis"),
+           "Hold the volume constant through this axis's length (undrained shearing of a dry sample)")
       .def("hold_isotropic", [](PySimulation& s, double p) {
             PySimulation::checkFinite(p, "p");
             if (p <= 0.0) throw py::value_error(fmt::format("p = {}; allowed: > 0", p));

@@ -47,7 +47,7 @@ lab::RunConfig benchConfig(int n) {
   lab::RunConfig c;
   c.sample.nParticles = n;
   c.sample.prepFrictionDeg = 5.0;
-  c.test.type = "isotropic";
+  c.test.type = lab::TestType::Isotropic;
   c.test.confiningPressure = 100e3;
   c.output.plots = false;
   return c;

@@ -430,9 +430,9 @@ int runCalibrate(const CalibrateOptions& opt) {
   const toml::table base = io::loadConfigTable(opt.config);
   const std::string baseDir = io::configBaseDir(opt.config);
   const lab::RunConfig config = io::parseConfig(base, baseDir);
-  if (config.test.type != "triaxial")
+  if (config.test.type != lab::TestType::Triaxial)
     throw InputError(fmt::format("calibrate {}: test.type = \"{}\": calibration fits a triaxial test (test.type = \"triaxial\")",
-                                 cut(opt.config), config.test.type));
+                                 cut(opt.config), lab::name(config.test.type)));
 
   const fs::path targetPath = opt.target;
   std::error_code ec;

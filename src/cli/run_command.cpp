@@ -34,6 +34,7 @@
 #include "lab/macro.hpp"
 #include "lab/micro_network.hpp"
 #include "lab/protocols.hpp"
+#include "lab/test_report.hpp"
 #include "lab/preflight.hpp"
 #include "lab/sphericity.hpp"
 
@@ -367,7 +368,9 @@ class RunSession {
     lab::ShearResult shear = lab_.continueShear();
     progress_.finish();
     const std::vector<lab::Record>& records = shear.records;
-    const bool simpleShear = config_.test.type == "simple-shear";
+    if (config_.test.type == lab::TestType::Oedometer || config_.test.type == lab::TestType::CyclicTriaxial)
+      return finishReversing(shear);
+    const bool simpleShear = config_.test.type == lab::TestType::SimpleShear;
     lab::TriaxialCurves curves;
     // Unload–reload loops: the macro-parameters of the monotonic curve; the loops give Eur.
     std::vector<double> loopEps1, loopQ;
@@ -381,7 +384,7 @@ class RunSession {
       curves.epsV.push_back(r.epsV);
       curves.sigma1.push_back(r.sigma1);
       // True triaxial: the minor principal stress; otherwise the mean lateral stress.
-      curves.sigma3.push_back(config_.test.type == "true-triaxial" ? r.sigma3 : 0.5 * (r.sigma2 + r.sigma3));
+      curves.sigma3.push_back(config_.test.type == lab::TestType::TrueTriaxial ? r.sigma3 : 0.5 * (r.sigma2 + r.sigma3));
       curves.voidRatio.push_back(r.e);
       curves.shearStress.push_back(r.tau);
     }
@@ -436,6 +439,7 @@ class RunSession {
         "critical_state_eps1 to the end, end_* those of the last window",
         criterion.csWindow, simpleShear ? "shear strain" : "axial strain", criterion.csMaxStressRatioRate,
         criterion.csMaxVolumetricRate, criterion.csMaxVoidRatioRate, criterion.csMinRecords);
+    if (lab_.protocol()->undrained()) undrainedKeys(records);
     summary_["strain_rate"] = shear.strainRate;
     summary_["inertial_number"] = shear.inertialNumber;
     summary_["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
@@ -473,6 +477,74 @@ class RunSession {
     if (inertialMax > 1e-3)
       std::fprintf(stderr, "grainlab: warning: inertial number reached %.2e > 1e-3: the test was not quasi-static\n",
                    inertialMax);
+    return writeResults(records, summary_.value("preparation_steps", 0L) + shear.steps);
+  }
+
+  // The undrained keys (lab/test_report.hpp), with a warning where the volume was not held.
+  void undrainedKeys(const std::vector<lab::Record>& records) {
+    const lab::UndrainedSummary u = lab::undrainedSummary(records, config_.test.confiningPressure, config_.test.ruLimit,
+                                                          lab_.protocol()->state.volumeDriftMax);
+    summary_["u_max"] = finite(u.uMax, "u_max");
+    summary_["p_min"] = finite(u.pMin, "p_min");
+    summary_["q_at_phase_transformation"] = u.qAtPhaseTransformation ? json(*u.qAtPhaseTransformation) : json(nullptr);
+    summary_["eps1_at_phase_transformation"] =
+        u.eps1AtPhaseTransformation ? json(*u.eps1AtPhaseTransformation) : json(nullptr);
+    summary_["liquefied"] = u.liquefied;
+    summary_["volume_drift_max"] = u.volumeDriftMax;
+    const double allowed = config_.test.boundary == "periodic" ? 1e-6 : 1e-5;
+    if (u.volumeDriftMax > allowed)
+      summary_["warnings"].push_back(fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})",
+                                                 u.volumeDriftMax, allowed));
+  }
+
+  // Oedometer and cyclic triaxial: their own macro-values (lab/test_report.hpp), not a monotonic
+  // curve's peak and residual.
+  int finishReversing(const lab::ShearResult& shear) {
+    const std::vector<lab::Record>& records = shear.records;
+    const lab::ShearProtocol& protocol = *lab_.protocol();
+    if (config_.test.type == lab::TestType::Oedometer) {
+      const lab::OedometerSummary o = lab::oedometerSummary(records, config_.test.confiningPressure);
+      auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+      summary_["K0"] = opt(o.k0);
+      summary_["K0_unloading"] = opt(o.k0Unloading);
+      summary_["Cc"] = opt(o.cc);
+      summary_["Cs"] = opt(o.cs);
+      summary_["sigma_v_max"] = o.sigmaVMax;
+      summary_["oedometer_method"] = fmt::format(
+          "lateral strain zero; K0 = sigma_h/sigma_v averaged over the {} loading records with sigma_v >= sqrt(p0 "
+          "sigma_v_max) (the start is isotropic), K0_unloading at the last record; Cc, Cs = -de/dlog10(sigma_v), "
+          "least-squares over the same loading records and over the {} unloading records",
+          o.loadingRecords, o.unloadingRecords);
+    } else {
+      const lab::CyclicSummary c = lab::cyclicSummary(protocol.state);
+      summary_["n_cycles_to_liquefaction"] = c.cyclesToLiquefaction ? json(*c.cyclesToLiquefaction) : json(nullptr);
+      summary_["ru_max"] = protocol.undrained() ? json(c.ruMax) : json(nullptr);
+      summary_["cycles"] = c.cycles;
+      summary_["double_amplitude_strain_max"] = c.doubleAmplitudeMax;
+      summary_["csr"] = config_.test.csr;
+      summary_["liquefaction_criterion"] = fmt::format(
+          "{}double-amplitude axial strain of a cycle >= {}; n_cycles_to_liquefaction counts the half cycle it "
+          "happened in (0.5: the first compression)",
+          protocol.undrained() ? fmt::format("u/p0 >= {} or ", config_.test.ruLimit) : std::string(),
+          config_.test.liquefactionDaStrain);
+      if (protocol.undrained()) {
+        summary_["volume_drift_max"] = protocol.state.volumeDriftMax;
+        const double allowed = config_.test.boundary == "periodic" ? 1e-6 : 1e-5;
+        if (protocol.state.volumeDriftMax > allowed)
+          summary_["warnings"].push_back(fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})",
+                                                     protocol.state.volumeDriftMax, allowed));
+      }
+    }
+    summary_["strain_rate"] = shear.strainRate;
+    summary_["inertial_number"] = shear.inertialNumber;
+    summary_["shear_pipeline"] = lab_.shearStageNames();
+    summary_["final_axial_strain"] = records.back().eps1;
+    summary_["shear_steps"] = shear.steps;
+    summary_["micro_at_end"] = microJson(records.back());
+    double inertialMax = 0.0;
+    for (const auto& r : records) inertialMax = std::max(inertialMax, r.inertialNumber);
+    summary_["inertial_number_max"] = inertialMax;
+    summary_["quasi_static"] = inertialMax <= 1e-3;
     return writeResults(records, summary_.value("preparation_steps", 0L) + shear.steps);
   }
 
@@ -616,7 +688,7 @@ class RunSession {
 
 int finish(RunSession& session, const lab::RunConfig& config) {
   try {
-    return config.test.type == "isotropic" ? session.finishIsotropic() : session.finishShear();
+    return config.test.type == lab::TestType::Isotropic ? session.finishIsotropic() : session.finishShear();
   } catch (const SimulationError& e) {
     session.writeFailure(e);
     throw;
@@ -724,7 +796,9 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
     summary["config_source"] = opt.config;
     summary["n_particles"] = packed ? packed->particles.size() : static_cast<std::size_t>(config.sample.nParticles);
     summary["confining_pressure"] = config.test.confiningPressure;
-    summary["test"] = config.test.type;
+    summary["test"] = std::string(lab::name(config.test.type));
+    if (lab::info(config.test.type).drainage)
+      summary["drainage"] = config.test.drainage == lab::Drainage::Undrained ? "undrained" : "drained";
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
     for (const auto& w : config.warnings) summary["warnings"].push_back(w);

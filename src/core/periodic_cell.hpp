@@ -38,6 +38,10 @@ struct ImageShift {
 enum class CellControl : std::uint8_t {
   StrainRate,  // the component of L is imposed
   Stress,      // the component of L follows the stress servo
+  // Diagonal components only: L_kk = -(sum of the other diagonal components)/(number of such
+  // components), so that tr L = 0 and the cell's volume is kept (det exp(L dt) = exp(tr L dt) = 1):
+  // an undrained (constant-volume) test on a dry sample.
+  ConstantVolume,
 };
 
 struct PeriodicCell {

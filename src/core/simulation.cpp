@@ -302,11 +302,37 @@ void Simulation::controlWalls() {
     inwardSpeed = std::clamp(inwardSpeed, -servo.maxSpeed, servo.maxSpeed);
     wall.velocity = wall.side == 0 ? inwardSpeed : -inwardSpeed;
   }
+  controlWallVolume();
   for (Wall& wall : box.walls) {
     // Work done on the particles by the wall: its force on them times its inward displacement.
     const double inward = wall.side == 0 ? wall.velocity : -wall.velocity;
     energy.boundaryWork += wall.normalForce * inward * dt;
     wall.position += wall.velocity * dt;
+  }
+}
+
+void Simulation::controlWallVolume() {
+  // Constant-volume axes: their walls move symmetrically so that the box after this step has the
+  // reference volume, given the lengths the other axes will have. The target is the reference
+  // volume itself, not the current one, so rounding does not accumulate into a drift.
+  int free = 0;
+  double fixedProduct = 1.0, freeProduct = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    const double next = box.length(a) + (box.upper(a).velocity - box.lower(a).velocity) * dt;
+    if (box.lower(a).control == WallControl::ConstantVolume) {
+      ++free;
+      freeProduct *= box.length(a);
+    } else {
+      fixedProduct *= next;
+    }
+  }
+  if (free == 0) return;
+  const double scale = std::pow(box.referenceVolume / (fixedProduct * freeProduct), 1.0 / free);
+  for (int a = 0; a < 3; ++a) {
+    if (box.lower(a).control != WallControl::ConstantVolume) continue;
+    const double speed = 0.5 * (scale - 1.0) * box.length(a) / dt;  // outward speed of each wall
+    box.lower(a).velocity = -speed;
+    box.upper(a).velocity = speed;
   }
 }
 
@@ -345,6 +371,7 @@ void Simulation::setCellGradient() {
   L.setZero();
   const Vec3 lengths = cell.h.diagonal();
   for (int k = 0; k < 3; ++k) {
+    if (cell.control[k] == CellControl::ConstantVolume) continue;  // below
     const double maxRate = 2.0 * servo.maxSpeed / lengths[k];
     const double rate = cell.control[k] == CellControl::StrainRate
                             ? cell.strainRate[k] * cell.referenceLength[k] / lengths[k]  // engineering rate on H0
@@ -352,6 +379,16 @@ void Simulation::setCellGradient() {
                                         cell.servoIntegral[k], maxRate);
     L(k, k) = -rate;
   }
+  // Constant-volume components take up what the others change, so that tr L = 0.
+  int free = 0;
+  double driven = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    if (cell.control[k] == CellControl::ConstantVolume) ++free;
+    else driven += L(k, k);
+  }
+  if (free > 0)
+    for (int k = 0; k < 3; ++k)
+      if (cell.control[k] == CellControl::ConstantVolume) L(k, k) = -driven / free;
   const Vec3 shear = cell.shearStress();
   for (int k = 0; k < 3; ++k) {
     if (cell.shearControl[k] != CellControl::Stress) continue;

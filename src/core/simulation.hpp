@@ -123,6 +123,7 @@ class Simulation {
   template <bool Periodic>
   void finishIntegration(const Mat3& deformation);
   void controlWalls();
+  void controlWallVolume();
   void controlCell();
   void setCellGradient();
   void wrapIntoCell();

@@ -110,13 +110,26 @@ void Simulation::validateState() const {
     if (!finiteIn(r, 0.0, 1e300)) bad("rolling friction not finite and >= 0");
   if (boundary == Boundary::Walls) {
     for (const Wall& w : box.walls)
-      if ((w.control != WallControl::Fixed && w.control != WallControl::Velocity && w.control != WallControl::Stress) ||
+      if ((w.control != WallControl::Fixed && w.control != WallControl::Velocity && w.control != WallControl::Stress &&
+           w.control != WallControl::ConstantVolume) ||
           !std::isfinite(w.targetStress) || !finiteIn(w.tanFriction, 0.0, 1e300))
         bad("wall control, target stress or friction invalid");
+    for (int a = 0; a < 3; ++a)
+      if ((box.lower(a).control == WallControl::ConstantVolume) != (box.upper(a).control == WallControl::ConstantVolume))
+        bad("constant-volume control on one wall of an axis only");
+    if (box.lower(0).control == WallControl::ConstantVolume || box.lower(1).control == WallControl::ConstantVolume ||
+        box.lower(2).control == WallControl::ConstantVolume)
+      if (!finiteIn(box.referenceVolume, 1e-300, 1e300)) bad("reference volume of constant-volume walls not positive");
   } else {
     auto knownControl = [](CellControl c) { return c == CellControl::StrainRate || c == CellControl::Stress; };
-    for (int k = 0; k < 3; ++k)
-      if (!knownControl(cell.control[k]) || !knownControl(cell.shearControl[k])) bad("unknown cell control");
+    int constantVolume = 0;
+    for (int k = 0; k < 3; ++k) {
+      constantVolume += cell.control[k] == CellControl::ConstantVolume;
+      if ((!knownControl(cell.control[k]) && cell.control[k] != CellControl::ConstantVolume) ||
+          !knownControl(cell.shearControl[k]))
+        bad("unknown cell control");
+    }
+    if (constantVolume == 3) bad("every cell axis at constant volume (one must be driven)");
     if (!cell.velocityGradient.allFinite() || !cell.targetStress.allFinite() || !cell.strainRate.allFinite() ||
         !cell.referenceLength.allFinite() || !(cell.referenceLength.minCoeff() > 0.0) ||
         !cell.targetShearStress.allFinite() || !cell.shearServoIntegral.allFinite() || !std::isfinite(cell.shearRate) ||

@@ -6,7 +6,10 @@
 
 namespace grainlab {
 
-enum class WallControl { Fixed, Velocity, Stress };
+// Fixed: still; Velocity: moves at `velocity`; Stress: servo to `targetStress`; ConstantVolume: the
+// two walls of the axis move apart or together so that the box keeps WallBox::referenceVolume
+// after the step, given how the other axes' walls move (an undrained test on a dry sample).
+enum class WallControl { Fixed, Velocity, Stress, ConstantVolume };
 
 struct Wall {
   int axis = 0;            // 0 x, 1 y, 2 z
@@ -34,6 +37,8 @@ struct Wall {
 
 struct WallBox {
   std::array<Wall, 6> walls;
+  // The volume ConstantVolume walls keep [m^3] (set when the control is chosen).
+  double referenceVolume = 0.0;
 
   static constexpr int index(int axis, int side) { return 2 * axis + side; }
   Wall& lower(int axis) { return walls[index(axis, 0)]; }

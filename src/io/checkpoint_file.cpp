@@ -46,7 +46,7 @@ std::string hex(std::uint64_t v) { return fmt::format("{:016x}", v); }
 std::uint64_t stateLayoutTag() {
   using stateio::fieldCount;
   // Everything whose size or field list shapes the bytes of Laboratory::saveState.
-  const std::array<std::uint64_t, 21> shape{
+  const std::array<std::uint64_t, 23> shape{
       kCheckpointFormat,
       fieldCount<Particles>(),
       sizeof(Wall),
@@ -68,6 +68,8 @@ std::uint64_t stateLayoutTag() {
       sizeof(ContactList<SphereSphere>),
       sizeof(ContactStore),
       lab::Record::kMicroColumns,
+      sizeof(lab::ProtocolState),
+      fieldCount<lab::ProtocolState>(),
   };
   return XXH64(shape.data(), sizeof(shape), 0);
 }

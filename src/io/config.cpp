@@ -202,7 +202,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"test",
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
-        "loop_rest", "unload_to_q_fraction", "cs_window"}},
+        "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
+        "n_cycles", "ru_limit", "liquefaction_da_strain"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
@@ -490,9 +491,11 @@ lab::ShapeConfig parseShape(Section& s) {
 std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   const bool packing = !c.sample.packing.empty();
   const std::string& method = c.sample.method;
-  const std::string& type = c.test.type;
+  const std::string type(lab::name(c.test.type));
+  const lab::TestType tt = c.test.type;
   const bool searched = method == "compaction" || method == "loose-moment-free";
-  const bool shear = type != "isotropic";
+  const bool shear = lab::shears(tt);
+  const bool monotonicAxial = tt == lab::TestType::Triaxial || tt == lab::TestType::ConstantP || tt == lab::TestType::TrueTriaxial;
   auto here = [](const char* k, const std::string& v) { return fmt::format("here {} = \"{}\"", k, v); };
   static const std::set<std::string> preparation{
       "sample.e0",           "sample.e0_tolerance", "sample.prep_friction_deg", "sample.initial_void_ratio",
@@ -527,13 +530,28 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "not used with contact.kn (every contact has the constant normal stiffness kn)";
   if (key == "test.b" && type != "true-triaxial")
     return "only used with test.type = \"true-triaxial\"; " + here("test.type", type);
-  if ((key == "test.axial_strain_rate" || key == "test.final_axial_strain") && (!shear || type == "simple-shear"))
+  if (key == "test.axial_strain_rate" && lab::info(tt).strain != lab::DrivingStrain::Axial)
+    return "only used with test.type = \"triaxial\", \"constant-p\", \"true-triaxial\", \"oedometer\" or "
+           "\"cyclic-triaxial\"; " + here("test.type", type);
+  if (key == "test.final_axial_strain" && !monotonicAxial)
     return "only used with test.type = \"triaxial\", \"constant-p\" or \"true-triaxial\"; " + here("test.type", type);
-  if ((key == "test.shear_strain_rate" || key == "test.final_shear_strain") && type != "simple-shear")
+  if (key == "test.cs_window" && !monotonicAxial && tt != lab::TestType::SimpleShear)
+    return "only used with the monotonic shearing tests (test.type = \"triaxial\", \"constant-p\", \"true-triaxial\" "
+           "or \"simple-shear\"); " + here("test.type", type);
+  if ((key == "test.shear_strain_rate" || key == "test.final_shear_strain") && tt != lab::TestType::SimpleShear)
     return "only used with test.type = \"simple-shear\"; " + here("test.type", type);
+  if (key == "test.drainage" && !lab::info(tt).drainage)
+    return "only used with test.type = \"triaxial\", \"simple-shear\" or \"cyclic-triaxial\"; " + here("test.type", type);
+  if ((key == "test.max_axial_stress" || key == "test.unload_axial_stress") && tt != lab::TestType::Oedometer)
+    return "only used with test.type = \"oedometer\"; " + here("test.type", type);
+  if ((key == "test.csr" || key == "test.n_cycles" || key == "test.liquefaction_da_strain") && tt != lab::TestType::CyclicTriaxial)
+    return "only used with test.type = \"cyclic-triaxial\"; " + here("test.type", type);
+  if (key == "test.ru_limit" && tt != lab::TestType::CyclicTriaxial &&
+      !(lab::info(tt).drainage && c.test.drainage == lab::Drainage::Undrained))
+    return "only used with test.type = \"cyclic-triaxial\" or an undrained test (test.drainage = \"undrained\")";
   if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
     return "only used with test.unload_reload_at (unload-reload loops)";
-  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed" || key == "test.cs_window") && !shear)
+  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed") && !shear)
     return "not used with test.type = \"isotropic\" (no shearing)";
   if (key == "solver.force_dt" && !c.solver.dt) return "only used with solver.dt (it allows a dt above the critical step)";
   if (key == "solver.damping" && c.solver.viscousDamping > 0.0)
@@ -570,7 +588,9 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
       // rate when it is run as an isotropic or simple-shear test): the other test's keys warn.
       static const std::set<std::string> testTypeKeys{
           "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
-          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window"};
+          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window",
+          "test.drainage", "test.max_axial_stress", "test.unload_axial_stress", "test.csr", "test.n_cycles",
+          "test.ru_limit", "test.liquefaction_da_strain"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
           otherTestsKey) {
@@ -799,10 +819,20 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   ct.finish();
 
   Section t(root, "test");
-  c.test.type = t.string("type", c.test.type, {"isotropic", "triaxial", "constant-p", "true-triaxial", "simple-shear"});
+  {
+    std::vector<std::string> names;
+    for (const lab::TestTypeInfo& i : lab::kTestTypes) names.emplace_back(i.name);
+    const std::string type = t.string("type", std::string(lab::name(c.test.type)), names);
+    c.test.type = *lab::parseTestType(type);  // one of names
+  }
   c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
-  if (c.test.type == "simple-shear" && c.test.boundary != "periodic")
-    fail("test.type", "\"simple-shear\"", "needs test.boundary = \"periodic\" (a wall box has no shearing walls)");
+  if (lab::info(c.test.type).periodicOnly && c.test.boundary != "periodic")
+    fail("test.type", fmt::format("\"{}\"", lab::name(c.test.type)),
+         "needs test.boundary = \"periodic\" (a wall box has no shearing walls)");
+  {
+    const std::string drainage = t.string("drainage", "drained", {"drained", "undrained"});
+    c.test.drainage = drainage == "undrained" ? lab::Drainage::Undrained : lab::Drainage::Drained;
+  }
   c.test.confiningPressure = t.number("confining_pressure", c.test.confiningPressure, 1.0, 1e10, false, false, "must be in [1, 1e10] [Pa]");
   if (const toml::node* n = t.raw("axial_strain_rate")) {
     if (n->is_string() && n->value<std::string>().value() == "auto") {
@@ -836,8 +866,8 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   if (const toml::node* n = t.raw("unload_reload_at")) {
     const std::string key = t.path("unload_reload_at");
     c.test.unloadReloadAt = t.numbers(*n, key);
-    if (c.test.type != "triaxial")
-      fail(key, show(*n), fmt::format("only for test.type = \"triaxial\" (here \"{}\")", c.test.type));
+    if (c.test.type != lab::TestType::Triaxial)
+      fail(key, show(*n), fmt::format("only for test.type = \"triaxial\" (here \"{}\")", lab::name(c.test.type)));
     for (std::size_t i = 0; i < c.test.unloadReloadAt.size(); ++i) {
       const double v = c.test.unloadReloadAt[i];
       if (!(v > 0.0) || !(v < c.test.finalAxialStrain))
@@ -854,6 +884,23 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.test.loopRest = t.boolean("loop_rest", c.test.loopRest);
   c.test.unloadToQFraction = t.number("unload_to_q_fraction", c.test.unloadToQFraction, 0.0, 1.0, false, true,
                                       "must be in [0, 1) (an unload ends at this fraction of the deviator at reversal)");
+  c.test.maxAxialStress = t.number("max_axial_stress", c.test.maxAxialStress, 1.0, 1e10, false, false,
+                                   "must be in [1, 1e10] [Pa] (the oedometer's loading ends there)");
+  if (!(c.test.maxAxialStress > c.test.confiningPressure))
+    fail("test.max_axial_stress", fmt::format("{}", c.test.maxAxialStress),
+         fmt::format("must be above test.confining_pressure = {} (the oedometer loads from there)", c.test.confiningPressure));
+  c.test.unloadAxialStress = t.number("unload_axial_stress", c.test.unloadAxialStress, 1.0, 1e10, false, false,
+                                      "must be in [1, 1e10] [Pa] (the oedometer's unloading ends there)");
+  if (!(c.test.unloadAxialStress < c.test.maxAxialStress))
+    fail("test.unload_axial_stress", fmt::format("{}", c.test.unloadAxialStress),
+         fmt::format("must be below test.max_axial_stress = {}", c.test.maxAxialStress));
+  c.test.csr = t.number("csr", c.test.csr, 0.0, 2.0, true, false,
+                        "must be in (0, 2] (cyclic stress ratio q_cyc / (2 p0))");
+  c.test.nCycles = t.integer("n_cycles", c.test.nCycles, 1, 100'000);
+  c.test.ruLimit = t.number("ru_limit", c.test.ruLimit, 0.0, 1.0, true, false,
+                            "must be in (0, 1] (excess pore-pressure ratio u/p0 at liquefaction)");
+  c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
+                                         "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
   t.finish();
 
   Section so(root, "solver");
@@ -967,7 +1014,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   } else {
     put(contact, "contact", "rolling_friction", c.contact.rollingFriction);
   }
-  toml::table test{{"type", c.test.type},
+  toml::table test{{"type", std::string(lab::name(c.test.type))},
                    {"boundary", c.test.boundary},
                    {"confining_pressure", c.test.confiningPressure},
                    {"probe_strain", c.test.probeStrain}};
@@ -989,6 +1036,13 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   else put(test, "test", "cs_window", "auto");
   if (c.test.shearStrainRate) put(test, "test", "shear_strain_rate", *c.test.shearStrainRate);
   else put(test, "test", "shear_strain_rate", "auto");
+  put(test, "test", "drainage", c.test.drainage == lab::Drainage::Undrained ? "undrained" : "drained");
+  put(test, "test", "max_axial_stress", c.test.maxAxialStress);
+  put(test, "test", "unload_axial_stress", c.test.unloadAxialStress);
+  put(test, "test", "csr", c.test.csr);
+  put(test, "test", "n_cycles", c.test.nCycles);
+  put(test, "test", "ru_limit", c.test.ruLimit);
+  put(test, "test", "liquefaction_da_strain", c.test.liquefactionDaStrain);
   toml::table solver{{"viscous_damping", c.solver.viscousDamping},
                      {"dt_factor", c.solver.dtFactor},
                      {"threads", c.solver.threads},

@@ -43,8 +43,11 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
   TimeseriesColumns c;
   c.periodic = config.test.boundary == "periodic";
-  c.simpleShear = config.test.type == "simple-shear";
-  c.trueTriaxial = config.test.type == "true-triaxial";
+  c.simpleShear = config.test.type == lab::TestType::SimpleShear;
+  c.trueTriaxial = config.test.type == lab::TestType::TrueTriaxial;
+  c.undrained = lab::info(config.test.type).drainage && config.test.drainage == lab::Drainage::Undrained;
+  c.cyclic = config.test.type == lab::TestType::CyclicTriaxial;
+  c.reversing = config.test.type == lab::TestType::Oedometer || c.cyclic;
   c.loops = !config.test.unloadReloadAt.empty();
   return c;
 }
@@ -60,6 +63,9 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   s += ",energy_residual";
   for (const auto& name : columns.micro) s += "," + name;
   if (columns.loops) s += ",loop_phase";
+  if (columns.undrained) s += ",u";
+  if (columns.cyclic) s += ",cycle";
+  if (columns.reversing) s += ",load_direction";
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -91,6 +97,9 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
     nullable(r.energyResidual);
     for (std::size_t k = 0; k < columns.micro.size(); ++k) nullable(r.micro.at(k));
     if (columns.loops) s += fmt::format(",{}", r.loopPhase);
+    if (columns.undrained) put(r.step, r.u);
+    if (columns.cyclic) put(r.step, r.cycle);
+    if (columns.reversing) s += fmt::format(",{}", r.loadDirection);
     s += '\n';
   }
   return s;

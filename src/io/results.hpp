@@ -23,6 +23,9 @@ struct TimeseriesColumns {
   std::vector<std::string> micro;
   // Unload–reload loops configured: loop_phase (Record::loopPhase) after the micromechanics.
   bool loops = false;
+  // Undrained tests: u (excess pore pressure); cyclic tests: cycle; oedometer and cyclic tests:
+  // load_direction (+1 loading, -1 unloading).
+  bool undrained = false, cyclic = false, reversing = false;
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 

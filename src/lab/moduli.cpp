@@ -77,7 +77,7 @@ ModulusProbe Laboratory::probeModuli() {
     probe.method = "not measured (test.probe_strain = 0)";
     return probe;
   }
-  if (config_.test.type == "simple-shear") {
+  if (config_.test.type == TestType::SimpleShear) {
     probe.method = "not measured (simple shear reports its shear modulus G)";
     return probe;
   }
@@ -85,7 +85,6 @@ ModulusProbe Laboratory::probeModuli() {
   // test that follows does not see it (and its results are bit-identical to a run without it).
   const Simulation saved = sim_;
   const double p = config_.test.confiningPressure;
-  const bool cell = sim_.boundary == Boundary::Periodic;
   // Equilibrium of the probe: both states much closer to rest than the test's tolerances, since the
   // stress increment is only ~E0 * probe_strain (a few % of p for a sand, less for soft contacts).
   const long maxSteps = std::min<long>(config_.solver.maxSteps, kProbeMaxSteps);
@@ -109,33 +108,23 @@ ModulusProbe Laboratory::probeModuli() {
     return ok;
   };
   // 1. The reference state: every boundary stress at p.
-  holdIsotropicStress(sim_, p);
+  BoundaryControl& b = boundary();
+  const Vec3 referenceLengths = b.referenceLengths();
+  const double referenceVolume = b.referenceVolume();
+  holdIsotropicStress(b, p);
   bool settled = settle(Vec3::Constant(p), true, kProbeStressTolerance * p);
-  const Vec3 s0 = boundaryStress(sim_);
-  const Vec3 l0 = sampleLengths(sim_);
+  const Vec3 s0 = b.stress();
+  const Vec3 l0 = b.lengths();
   // 2. The lateral boundaries now hold exactly the stresses of the reference state (each wall its
   // own), so that what the servo leaves of d_sigma3 is measured against the reference, not against p.
-  if (cell) {
-    sim_.cell.targetStress[0] = s0[0];
-    sim_.cell.targetStress[1] = s0[1];
-  } else {
-    const std::array<double, 6> walls = singleWallStresses(sim_);
-    for (int a = 0; a < 2; ++a)
-      for (int side = 0; side < 2; ++side) sim_.box.walls[WallBox::index(a, side)].targetStress = walls[WallBox::index(a, side)];
-  }
+  const std::array<double, 6> faces = b.faceStresses();
+  for (int a = 0; a < 2; ++a)
+    for (int side = 0; side < 2; ++side) b.holdFaceStress(a, side, faces[WallBox::index(a, side)]);
   // 3. The axial increment, imposed at a constant rate over kProbeSteps steps; then the axis is
   // held still while the sample comes to rest.
   const double rate = probe.strain / (static_cast<double>(kProbeSteps) * sim_.dt);
-  if (cell) {
-    sim_.cell.referenceLength = sim_.cell.h.diagonal();
-    sim_.cell.control[2] = CellControl::StrainRate;
-    sim_.cell.strainRate[2] = rate;
-  } else {
-    sim_.box.lower(2).control = WallControl::Velocity;
-    sim_.box.upper(2).control = WallControl::Velocity;
-    sim_.box.lower(2).velocity = 0.5 * rate * l0[2];
-    sim_.box.upper(2).velocity = -0.5 * rate * l0[2];
-  }
+  b.setReference();
+  b.imposeStrainRate(2, rate);
   {
     Pipeline pipeline(sim_);
     pipeline.addAfter("probe drive", [&] {
@@ -143,21 +132,15 @@ ModulusProbe Laboratory::probeModuli() {
     });
     probe.steps += pipeline.run();
   }
-  if (cell) {
-    sim_.cell.strainRate[2] = 0.0;
-  } else {
-    sim_.box.lower(2).control = WallControl::Fixed;
-    sim_.box.upper(2).control = WallControl::Fixed;
-    sim_.box.lower(2).velocity = 0.0;
-    sim_.box.upper(2).velocity = 0.0;
-  }
+  b.fix(2);
   // The lateral stresses must come back to the reference within a small fraction of the axial
   // increment (whatever is left is corrected by elasticFromIncrement).
   const double dSigma1Driven = std::abs(boundaryStress(sim_)[2] - s0[2]);
   settled = settle(s0, false, std::max(kProbeLateralFraction * dSigma1Driven, 1e-9 * p)) && settled;
-  const Vec3 s1 = boundaryStress(sim_);
-  const Vec3 l1 = sampleLengths(sim_);
+  const Vec3 s1 = b.stress();
+  const Vec3 l1 = b.lengths();
   sim_ = saved;
+  b.restoreReference(referenceLengths, referenceVolume);
 
   probe.settled = settled;
   probe.dSigma1 = s1[2] - s0[2];

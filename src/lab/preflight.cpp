@@ -51,8 +51,10 @@ void checkDerived(const RunConfig& c, const Simulation& sim) {
 // The steps of the test phase, final strain / (rate x dt), against solver.max_steps.
 void checkTestSteps(const RunConfig& c, const Simulation& sim, double d50) {
   const TestConfig& t = c.test;
-  if (t.type == "isotropic") return;
-  const bool shear = t.type == "simple-shear";
+  // The oedometer's and the cyclic tests' lengths follow from the sample's response (where the stress
+  // reaches its target, when it liquefies), not from a final strain: solver.max_steps guards them.
+  if (t.type == TestType::Isotropic || t.type == TestType::Oedometer || t.type == TestType::CyclicTriaxial) return;
+  const bool shear = t.type == TestType::SimpleShear;
   const std::optional<double> given = shear ? t.shearStrainRate : t.axialStrainRate;
   const double rate = given.value_or(Laboratory::kAutoInertialNumber / (d50 * std::sqrt(c.sample.density / t.confiningPressure)));
   const double final = shear ? t.finalShearStrain : t.finalAxialStrain;

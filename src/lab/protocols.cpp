@@ -48,28 +48,38 @@ void configureSolver(const RunConfig& c, Simulation& sim) {
 }
 
 void holdIsotropicStress(Simulation& sim, double pressure) {
-  if (sim.boundary == Boundary::Periodic) {
-    for (int k = 0; k < 3; ++k) {
-      sim.cell.control[k] = CellControl::Stress;
-      sim.cell.targetStress[k] = pressure;
-      sim.cell.shearControl[k] = CellControl::Stress;
-      sim.cell.targetShearStress[k] = 0.0;
-    }
-    sim.cell.shearRate = 0.0;
-    return;
-  }
-  for (Wall& w : sim.box.walls) {
-    w.control = WallControl::Stress;
-    w.targetStress = pressure;
-  }
+  holdIsotropicStress(*BoundaryControl::of(sim), pressure);
 }
 
 Laboratory::Laboratory(const RunConfig& config, ProgressFn progress)
     : config_(config), progress_(std::move(progress)) {
   sim_.boundary = config.test.boundary == "periodic" ? Boundary::Periodic : Boundary::Walls;
+  boundary_ = BoundaryControl::of(sim_);
   // Ellipsoid samples get the shape columns too (a_tau, a_E, ... of lab/micromechanics.hpp).
   microColumns_.nonSpherical = config.sample.shape.type == "ellipsoid";
   static_assert(Record::kMicroColumns >= 11 + 2 + 6 * 3 + 2, "room for every micromechanical column");
+}
+
+Laboratory::Laboratory(const Laboratory& o)
+    : config_(o.config_),
+      progress_(o.progress_),
+      snapshot_(o.snapshot_),
+      snapshotEvery_(o.snapshotEvery_),
+      checkpoint_(o.checkpoint_),
+      checkpointEvery_(o.checkpointEvery_),
+      shear_(o.shear_),
+      sim_(o.sim_),
+      records_(o.records_),
+      micro_(o.micro_),
+      microColumns_(o.microColumns_),
+      d50_(o.d50_),
+      growthCurve_(o.growthCurve_) {
+  boundary_ = BoundaryControl::of(sim_);
+  boundary_->restoreReference(o.boundary_->referenceLengths(), o.boundary_->referenceVolume());
+  if (o.protocol_) {
+    protocol_ = ShearProtocol::make(config_);
+    protocol_->state = o.protocol_->state;
+  }
 }
 
 EquilibriumState Laboratory::equilibriumState() const {
@@ -243,7 +253,6 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.h0);
   put(out, st.v0);
   put(out, st.l0);
-  put(out, st.loadingSpeed);
   put(out, st.rampSteps);
   put(out, st.startStep);
   put(out, st.nextRecord);
@@ -266,6 +275,8 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.loopEndStep);
   put(out, st.loopRestStart);
   put(out, st.slowdown);
+  put(out, protocol_ != nullptr);
+  if (protocol_) put(out, protocol_->state);
 }
 
 void Laboratory::loadState(std::istream& in) {
@@ -278,7 +289,6 @@ void Laboratory::loadState(std::istream& in) {
   get(in, st.h0);
   get(in, st.v0);
   get(in, st.l0);
-  get(in, st.loadingSpeed);
   get(in, st.rampSteps);
   get(in, st.startStep);
   get(in, st.nextRecord);
@@ -301,6 +311,21 @@ void Laboratory::loadState(std::istream& in) {
   get(in, st.loopEndStep);
   get(in, st.loopRestStart);
   get(in, st.slowdown);
+  bool hasProtocol = false;
+  get(in, hasProtocol);
+  if (hasProtocol != st.started) throw std::runtime_error("inconsistent state: a shearing protocol's state without shearing, or none with it");
+  if (hasProtocol) {
+    protocol_ = ShearProtocol::make(config_);
+    get(in, protocol_->state);
+    const ProtocolState& ps = protocol_->state;
+    if ((ps.direction != 1 && ps.direction != -1) || !(ps.path >= 0.0) || !std::isfinite(ps.path) || ps.halfCycles < 0 ||
+        !std::isfinite(ps.lastEps1) || !std::isfinite(ps.ruMax) || !(ps.volumeDriftMax >= 0.0) ||
+        !std::isfinite(ps.volumeDriftMax))
+      throw std::runtime_error("inconsistent state: the shearing protocol's state");
+    boundary_->restoreReference(st.l0, st.v0);
+  } else {
+    protocol_.reset();
+  }
   if (!(st.slowdown > 0.0 && st.slowdown <= 1.0)) throw std::runtime_error("inconsistent state: platen slow-down factor");
   if (st.loopNext < 0 || st.loopNext > static_cast<int>(config_.test.unloadReloadAt.size()) || st.loopPhase < 0 ||
       st.loopPhase > 3 || (st.loopPhase == 3 && !config_.test.loopRest) || (st.loopPhase != 0 && st.loopNext == static_cast<int>(config_.test.unloadReloadAt.size())))

@@ -18,6 +18,7 @@
 #include "lab/kinematics.hpp"
 #include "lab/micromechanics.hpp"
 #include "lab/moduli.hpp"
+#include "lab/protocol/shear_protocol.hpp"
 #include "lab/run_config.hpp"
 
 namespace grainlab::lab {
@@ -68,6 +69,12 @@ struct Record {
   // Triaxial unload–reload loops (test.unload_reload_at): 0 monotonic loading, 1 unloading,
   // 2 reloading, 3 at rest at the reversal strain before the unload (test.loop_rest).
   long loopPhase = 0;
+  // Undrained tests: excess pore pressure u [Pa] (ShearProtocol::excessPorePressure); p, q and
+  // sigma1..3 stay the effective stresses the grains carry.
+  double u = 0.0;
+  // Cyclic tests: cycles completed (in halves); oedometer and cyclic: +1 loading, -1 unloading.
+  double cycle = 0.0;
+  long loadDirection = 1;
 };
 
 struct EquilibriumState {
@@ -111,6 +118,10 @@ struct ShearResult {
 class Laboratory {
  public:
   Laboratory(const RunConfig& config, ProgressFn progress = {});
+  // A copy has its own boundary control over its own engine and its own protocol (they refer to the
+  // laboratory's engine and config), in the state of the original's.
+  Laboratory(const Laboratory& other);
+  Laboratory& operator=(const Laboratory&) = delete;
 
   // Draws the grading, places particles loosely and prepares the sample (compaction with the
   // preparation friction, searched when not given, or frictionless growth), then re-equilibrates at
@@ -201,7 +212,6 @@ class Laboratory {
     bool started = false;
     double h0 = 0.0, v0 = 0.0;
     Vec3 l0 = Vec3::Zero();
-    double loadingSpeed = 0.0;  // platen speed [m/s] (walls) or strain rate [1/s] (cell), at full ramp
     long rampSteps = 1, startStep = 0;
     double nextRecord = 0.0, nextSnapshot = 0.0, nextCheckpoint = 0.0;
     // Boundary stresses summed over the steps since the last record: a record carries their mean.
@@ -220,6 +230,14 @@ class Laboratory {
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
   };
+ public:
+  // The shearing protocol of the test (null before beginShear) and the boundary's controls.
+  const ShearProtocol* protocol() const { return protocol_.get(); }
+  BoundaryControl& boundary() const { return *boundary_; }
+
+ private:
+  std::unique_ptr<ShearProtocol> protocol_;
+  std::unique_ptr<BoundaryControl> boundary_;  // over sim_, made once the boundary kind is known
   // Platen speed factor of the current step: the start-up ramp, or a loop's (negative while unloading).
   double loadingFactor() const;
   ShearState shear_;
@@ -239,10 +257,6 @@ class Laboratory {
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
   // Current strain of the test: axial strain, or gamma in simple shear.
   double testStrain() const;
-  double finalStrain() const;
-  // Sets the boundary's drive and stress targets for the current step of the test.
-  void driveBoundary(double ramp);
-  void configureShearBoundary();
   void buildShearPipeline(Pipeline& pipeline);
 };
 

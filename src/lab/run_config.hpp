@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/servo_settings.hpp"
+#include "lab/test_type.hpp"
 
 namespace grainlab::lab {
 
@@ -108,8 +109,11 @@ struct ContactConfig {
 };
 
 struct TestConfig {
-  // "isotropic" | "triaxial" | "constant-p" | "true-triaxial" | "simple-shear" (periodic only)
-  std::string type = "triaxial";
+  // test.type: one of kTestTypes (lab/test_type.hpp)
+  TestType type = TestType::Triaxial;
+  // test.drainage (triaxial, simple-shear, cyclic-triaxial): undrained = constant volume, the
+  // change of total lateral stress the constraint produces read as the excess pore pressure u.
+  Drainage drainage = Drainage::Drained;
   std::string boundary = "walls";     // "walls" | "periodic"
   double confiningPressure = 100.0e3; // [Pa]; the mean stress of constant-p and true-triaxial, the
                                       // normal stress of simple-shear
@@ -142,6 +146,15 @@ struct TestConfig {
   // when a force-chain column collapses and the sample contracts faster than 0.5 m/s lets them
   // follow (docs/moduli.md, "Lateral stress in column collapses").
   double servoMaxSpeed = 2.0;
+  // Oedometer: axial stress at which loading turns to unloading, and where unloading ends [Pa].
+  double maxAxialStress = 1.0e6;
+  double unloadAxialStress = 100.0e3;
+  // Cyclic triaxial: cyclic stress ratio q_cyc/(2 p0), the number of cycles at most, and the
+  // liquefaction criteria (excess pore-pressure ratio u/p0 and double-amplitude axial strain).
+  double csr = 0.2;
+  long nCycles = 20;
+  double ruLimit = 0.95;
+  double liquefactionDaStrain = 0.05;
 };
 
 struct SolverConfig {

@@ -15,36 +15,10 @@
 
 namespace grainlab::lab {
 
-namespace {
-
-// Lateral stress targets (x = sigma2, y = sigma3) of a stress path, given the axial stress sigma1.
-// A granular sample carries no tension, so a target is never below zero (at constant p that
-// happens once sigma1 > 3p, which a sample with strong contact moments can reach: the mean stress
-// then exceeds p, and the records show it).
-Vec3 lateralTargets(const TestConfig& t, double sigma1) {
-  const double p = t.confiningPressure;
-  Vec3 target(p, p, 0.0);
-  if (t.type == "constant-p") {
-    target.head<2>().setConstant(0.5 * (3.0 * p - sigma1));
-  } else if (t.type == "true-triaxial") {
-    // p = (s1 + s2 + s3)/3 and b = (s2 - s3)/(s1 - s3) held: s3 = (3p - (1 + b) s1)/(2 - b).
-    const double s3 = (3.0 * p - (1.0 + t.b) * sigma1) / (2.0 - t.b);
-    target = Vec3(s3 + t.b * (sigma1 - s3), s3, 0.0);
-  }
-  return target.cwiseMax(0.0);
-}
-
-bool simpleShear(const TestConfig& t) { return t.type == "simple-shear"; }
-
-}  // namespace
-
 double Laboratory::testStrain() const {
-  if (simpleShear(config_.test)) return sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
-  return (shear_.h0 - sampleLengths(sim_)[2]) / shear_.h0;
-}
-
-double Laboratory::finalStrain() const {
-  return simpleShear(config_.test) ? config_.test.finalShearStrain : config_.test.finalAxialStrain;
+  // Before shearing: the strain of the test that is to come, zero.
+  if (!protocol_) return 0.0;
+  return protocol_->strain(boundary());
 }
 
 Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const {
@@ -68,7 +42,7 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3.0;
   r.e = voidRatio(sim_);
   const TestConfig& t = config_.test;
-  if (t.type == "true-triaxial") {
+  if (t.type == TestType::TrueTriaxial) {
     r.phiDeg = mobilisedFrictionDeg(r.sigma1, r.sigma3);
     r.b = std::abs(r.sigma1 - r.sigma3) > 1e-9 * r.p ? (r.sigma2 - r.sigma3) / (r.sigma1 - r.sigma3)
                                                       : std::numeric_limits<double>::quiet_NaN();
@@ -96,7 +70,7 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
     r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);
     r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
     r.tau = meanStress ? meanShearStress : -0.5 * (sc(0, 2) + sc(2, 0));
-    if (simpleShear(t)) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
+    if (t.type == TestType::SimpleShear) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
   }
   const GrainKinematics k = currentKinematics();
   r.rotationMeanDeg = k.rotationMeanDeg;
@@ -118,64 +92,8 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.micro.fill(std::numeric_limits<double>::quiet_NaN());
   for (std::size_t k = 0; k < micro.size() && k < r.micro.size(); ++k)
     if (micro[k]) r.micro[k] = *micro[k];
+  if (protocol_) protocol_->completeRecord(r);
   return r;
-}
-
-void Laboratory::configureShearBoundary() {
-  const TestConfig& t = config_.test;
-  const double p = t.confiningPressure;
-  if (sim_.boundary == Boundary::Periodic) {
-    PeriodicCell& cell = sim_.cell;
-    cell.referenceLength = cell.h.diagonal();
-    cell.servoIntegral.setZero();
-    // The cell keeps its shape in shear (principal axes fixed; simple shear adds its own L_xz).
-    cell.shearControl = {CellControl::StrainRate, CellControl::StrainRate, CellControl::StrainRate};
-    if (simpleShear(t)) {
-      // Constant normal stress on z; no lateral strain (the cell's x and y edges keep their length).
-      cell.control = {CellControl::StrainRate, CellControl::StrainRate, CellControl::Stress};
-      cell.strainRate.setZero();
-      cell.targetStress = Vec3(0.0, 0.0, p);
-    } else {
-      cell.control = {CellControl::Stress, CellControl::Stress, CellControl::StrainRate};
-      cell.strainRate.setZero();
-      cell.targetStress = Vec3(p, p, 0.0);
-    }
-    return;
-  }
-  WallBox& box = sim_.box;
-  for (int a = 0; a < 2; ++a)
-    for (int side = 0; side < 2; ++side) {
-      Wall& w = box.walls[WallBox::index(a, side)];
-      w.control = WallControl::Stress;
-      w.targetStress = p;
-    }
-  box.lower(2).control = WallControl::Velocity;
-  box.upper(2).control = WallControl::Velocity;
-}
-
-void Laboratory::driveBoundary(double ramp) {
-  const TestConfig& t = config_.test;
-  ShearState& st = shear_;
-  if (sim_.boundary == Boundary::Periodic) {
-    if (simpleShear(t)) sim_.cell.shearRate = ramp * st.loadingSpeed;
-    else sim_.cell.strainRate[2] = ramp * st.loadingSpeed;
-  } else {
-    sim_.box.lower(2).velocity = ramp * st.loadingSpeed;
-    sim_.box.upper(2).velocity = -ramp * st.loadingSpeed;
-  }
-  if (t.type == "constant-p" || t.type == "true-triaxial") {
-    // The stress path: lateral targets follow the axial stress of the previous step.
-    const Vec3 target = lateralTargets(t, boundaryStress(sim_)[2]);
-    if (sim_.boundary == Boundary::Periodic) {
-      sim_.cell.targetStress[0] = target[0];
-      sim_.cell.targetStress[1] = target[1];
-    } else {
-      for (int side = 0; side < 2; ++side) {
-        sim_.box.walls[WallBox::index(0, side)].targetStress = target[0];
-        sim_.box.walls[WallBox::index(1, side)].targetStress = target[1];
-      }
-    }
-  }
 }
 
 double Laboratory::loadingFactor() const {
@@ -198,23 +116,24 @@ void Laboratory::beginShear() {
   const double p = t.confiningPressure;
   const double rho = config_.sample.density;
   setFriction(config_.contact.frictionDeg);
+  protocol_ = ShearProtocol::make(config_);
   // "auto": the fastest rate with inertial number I = rate d50 sqrt(rho/p) <= 1e-3, aimed at
   // kAutoInertialNumber (2 % below the limit) so that the servo's small dips of p stay under it.
-  const std::optional<double> given = simpleShear(t) ? t.shearStrainRate : t.axialStrainRate;
-  st.result.strainRate = given.value_or(kAutoInertialNumber / (d50_ * std::sqrt(rho / p)));
+  st.result.strainRate = protocol_->givenRate().value_or(protocol_->autoRateFactor() * kAutoInertialNumber /
+                                                         (d50_ * std::sqrt(rho / p)));
   st.result.inertialNumber = st.result.strainRate * d50_ * std::sqrt(rho / p);
 
-  const Vec3 len = sampleLengths(sim_);
-  st.h0 = len[2];
-  st.v0 = sim_.volume();
-  st.l0 = len;
-  configureShearBoundary();
+  BoundaryControl& b = boundary();
+  b.beginTest();
+  st.h0 = b.referenceLengths()[2];
+  st.v0 = b.referenceVolume();
+  st.l0 = b.referenceLengths();
+  protocol_->configure(b);
   // Walls: platens at constant speed, the engineering axial strain rate on the initial height. Cell:
   // the same engineering rate of H_zz (or the shear rate). The rate is ramped up linearly over
   // kPlatenRampIntegralTimes servo integral times, so that the lateral servos learn how fast their
   // boundaries must move instead of lagging behind a sudden start (with the stiff contacts of [W]
   // sigma1 rises by several times p within 0.05 % of axial strain).
-  st.loadingSpeed = sim_.boundary == Boundary::Periodic ? st.result.strainRate : 0.5 * st.result.strainRate * st.h0;
   st.rampSteps = std::max(1L, static_cast<long>(kPlatenRampIntegralTimes * config_.solver.servoIntegralSteps));
   st.started = true;
   records_.reset(sim_);
@@ -236,23 +155,29 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
   ShearState& st = shear_;
   const TestConfig& t = config_.test;
   const double p = t.confiningPressure;
-  const double final = finalStrain();
   const double every = config_.output.recordEveryStrain;
-  const std::string phase = t.type == "triaxial" ? std::string("triaxial shearing") : t.type;
+  const std::string phase(protocol_->info().phase);
+  ShearProtocol& protocol = *protocol_;
+  BoundaryControl& b = boundary();
+  // strain: the protocol's progress variable (records, snapshots and checkpoints are spaced in it);
+  // axial: the strain it imposes (unload-reload loops).
   auto strain = std::make_shared<double>(0.0);
+  auto axial = std::make_shared<double>(0.0);
   auto last = std::make_shared<bool>(false);
 
-  pipeline.addBefore("loading drive", [this] { driveBoundary(loadingFactor()); });
+  pipeline.addBefore("loading drive", [this, &protocol, &b, &st] { protocol.drive(b, st.result.strainRate, loadingFactor()); });
   pipeline.addAfter("rotation record", [this] { records_.accumulateRotation(sim_.particles, sim_.dt); });
-  pipeline.addAfter("load cell", [this, &st, strain, last, final] {
+  pipeline.addAfter("protocol", [&protocol, &b] { protocol.afterStep(b); });
+  pipeline.addAfter("load cell", [this, &st, &protocol, &b, strain, axial, last] {
     const Mat3 sc = sim_.boundary == Boundary::Periodic ? sim_.cell.stress : Mat3::Zero();
     st.stressSum += boundaryStress(sim_);
     st.shearStressSum -= 0.5 * (sc(0, 2) + sc(2, 0));
     const auto walls = singleWallStresses(sim_);
     for (int k = 0; k < 6; ++k) st.wallStressSum[k] += walls[k];
     ++st.stressSamples;
-    *strain = testStrain();
-    *last = *strain >= final;
+    *axial = protocol.strain(b);
+    *strain = protocol.progress(b);
+    *last = protocol.finished(b);
   });
   if (t.platenSlowdownUnbalanced > 0.0)
     pipeline.addAfter("platen slow-down", [this, &st] {
@@ -263,7 +188,7 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
       st.slowdown = unbalanced > threshold ? std::max(kMinPlatenSlowdown, threshold / unbalanced) : 1.0;
     }, Pipeline::Trigger::onlyIf([this] { return sim_.stepCount % kSlowdownCheckSteps == 0; }));  // resumes in phase
   if (!t.unloadReloadAt.empty())
-    pipeline.addAfter("unload-reload", [this, &st, strain] {
+    pipeline.addAfter("unload-reload", [this, &st, strain = axial] {
       // Reversal at the loop's strain, turning point at the stated fraction of the deviator at
       // reversal, end where the reload regains the reversal strain (the instantaneous wall stresses).
       const std::vector<double>& at = config_.test.unloadReloadAt;
@@ -294,19 +219,19 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
         st.forceRecord = true;
       }
     });
-  pipeline.addAfter("record", [this, &st, strain, last, every, p] {
+  pipeline.addAfter("record", [this, &st, &protocol, strain, axial, last, every, p] {
     const bool loopDue = st.loopPhase != 0 && !st.result.records.empty() &&
-                         (std::abs(*strain - st.result.records.back().eps1) >= kLoopRecordFraction * every ||
+                         (std::abs(*axial - st.result.records.back().eps1) >= kLoopRecordFraction * every ||
                           (st.loopPhase == 3 && sim_.stepCount - st.result.records.back().step >= kLoopRestRecordSteps));
-    if (!(*strain >= st.nextRecord || *last || st.forceRecord || loopDue)) return;
+    if (!(*strain >= st.nextRecord || *last || st.forceRecord || loopDue || protocol.recordDue())) return;
     st.forceRecord = false;
     const double samples = static_cast<double>(st.stressSamples);
     const Vec3 meanStress = st.stressSum / samples;
     Record r = measure(&meanStress, st.shearStressSum / samples);
     // How well the boundary held its lateral targets, as a fraction of p: the mean of the two
     // opposite walls (what the stresses report) and the worst single wall.
-    const Vec3 target = lateralTargets(config_.test, r.sigma1);
-    if (!simpleShear(config_.test)) {
+    if (const std::optional<Vec3> lateral = protocol.lateralTargets(r.sigma1)) {
+      const Vec3& target = *lateral;
       st.result.maxLateralDeviation = std::max(
           {st.result.maxLateralDeviation, std::abs(r.sigma2 - target[0]) / p, std::abs(r.sigma3 - target[1]) / p});
       if (sim_.boundary == Boundary::Walls)
@@ -321,6 +246,7 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     st.wallStressSum.fill(0.0);
     st.stressSamples = 0;
     r.loopPhase = st.loopPhase;
+    protocol.recorded(r);
     st.result.records.push_back(r);
     while (st.nextRecord <= *strain) st.nextRecord += *strain < 0.01 ? 0.1 * every : every;
   });
@@ -329,11 +255,11 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     snapshot_(sim_, *strain);
     while (st.nextSnapshot <= *strain) st.nextSnapshot += snapshotEvery_;
   });
-  pipeline.addAfter("progress", [this, &st, strain, final, phase] {
+  pipeline.addAfter("progress", [this, &st, &protocol, &b, phase] {
     if (progress_ && (sim_.stepCount - st.startStep) % 2000 == 0)
-      progress_(phase, std::min(1.0, *strain / final), sim_.stepCount - st.startStep);
+      progress_(phase, protocol.fractionDone(b), sim_.stepCount - st.startStep);
   });
-  pipeline.addAfter("stop at the final strain", [&pipeline, last] {
+  pipeline.addAfter("stop at the end of the test", [&pipeline, last] {
     if (*last) pipeline.stop();
   });
   // Checkpoints between steps, after the step's records and snapshots: a resumed run repeats none.
@@ -362,8 +288,7 @@ ShearResult Laboratory::continueShear() {
   Pipeline pipeline(sim_);
   buildShearPipeline(pipeline);
   pipeline.run();
-  const std::string phase = config_.test.type == "triaxial" ? std::string("triaxial shearing") : config_.test.type;
-  if (progress_) progress_(phase, 1.0, sim_.stepCount - st.startStep);
+  if (progress_) progress_(std::string(protocol_->info().phase), 1.0, sim_.stepCount - st.startStep);
   st.result.steps = sim_.stepCount - st.startStep;
   return st.result;
 }

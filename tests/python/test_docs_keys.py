@@ -116,6 +116,8 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "true-triaxial": '[test]\ntype = "true-triaxial"\n',
         "loops": '[test]\nunload_reload_at = [0.05]\n',
         "simple-shear": '[test]\ntype = "simple-shear"\nboundary = "periodic"\n',
+        "oedometer": '[test]\ntype = "oedometer"\n',
+        "cyclic-triaxial": '[test]\ntype = "cyclic-triaxial"\n',
         "dt": '[solver]\ndt = 1e-7\n',
     }
     printed = {}
@@ -201,11 +203,12 @@ def test_timeseries_columns_are_documented_in_order(short_run):
     # The columns of the other tests, where results.cpp inserts them: before energy_residual.
     src = read("src", "io", "results.cpp")
     extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
-    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops"}, extra
+    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops", "undrained", "cyclic", "reversing"}, extra
     i = header.index("energy_residual")
-    # The unload-reload column comes last, after the micromechanics columns.
+    # The unload-reload column and the undrained, cyclic and reversing tests' columns come last,
+    # after the micromechanics columns.
     expected = (header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")]
-                + header[i:] + extra["loops"].split(","))
+                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing") for n in extra[k].split(",")])
     rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
     documented = [n for cells in rows[2:] for n in names_in(cells[0])]
     assert documented == expected
@@ -217,6 +220,12 @@ SUMMARY_ONLY_SOMETIMES = {
     "growth_curve",                        # ellipsoid shape growth
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
+    # undrained tests
+    "u_max", "p_min", "q_at_phase_transformation", "eps1_at_phase_transformation", "liquefied", "volume_drift_max",
+    # oedometer
+    "K0", "K0_unloading", "Cc", "Cs", "sigma_v_max", "oedometer_method",
+    # cyclic triaxial
+    "n_cycles_to_liquefaction", "ru_max", "cycles", "double_amplitude_strain_max", "csr", "liquefaction_criterion",
 }
 
 

@@ -36,7 +36,7 @@ inline lab::RunConfig simpleCubicLattice(int n, double stiffnessNumber) {
   c.sample.grading.dMin = c.sample.grading.dMax = 2e-3;
   c.sample.prepRampSteps = 2000;
   c.test.boundary = "periodic";
-  c.test.type = "isotropic";
+  c.test.type = lab::TestType::Isotropic;
   c.contact.kn = stiffnessNumber * c.test.confiningPressure * 2e-3;  // [N/m]
   return c;
 }

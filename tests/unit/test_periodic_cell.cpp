@@ -213,7 +213,7 @@ lab::RunConfig periodicConfig(int n, double pressure, double young) {
   c.sample.prepFrictionDeg = 10.0;
   c.sample.prepRampSteps = 4000;
   c.test.boundary = "periodic";
-  c.test.type = "isotropic";
+  c.test.type = lab::TestType::Isotropic;
   c.test.confiningPressure = pressure;
   c.contact.young = young;
   return c;

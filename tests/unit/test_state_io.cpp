@@ -33,7 +33,6 @@ struct ShearStateMembers {
   bool started;
   double h0, v0;
   Vec3 l0;
-  double loadingSpeed;
   long rampSteps, startStep;
   double nextRecord, nextSnapshot, nextCheckpoint;
   Vec3 stressSum;
@@ -84,6 +83,7 @@ static_assert(sizeof(Simulation) ==
               "step's chunk sums and error state are scratch)");
 static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
+                             std::unique_ptr<lab::ShearProtocol>, std::unique_ptr<lab::BoundaryControl>,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
                              lab::MicroColumnSet, double, std::vector<lab::GrowthStage>>(),
               "Laboratory changed: update Laboratory::saveState/loadState and this list");
@@ -94,7 +94,7 @@ static_assert(std::is_trivially_copyable_v<Wall> && std::is_trivially_copyable_v
 // components), nor is a struct holding a vector (its heap pointer would be written).
 static_assert(!stateio::Bytewise<Vec3> && !stateio::Bytewise<Quat> && !stateio::Bytewise<lab::ShearResult>);
 static_assert(!stateio::Bytewise<bool> && !stateio::Bytewise<double*>);
-static_assert(stateio::Bytewise<Wall> && stateio::Bytewise<lab::Record>);
+static_assert(stateio::Bytewise<Wall> && stateio::Bytewise<lab::Record> && stateio::Bytewise<lab::ProtocolState>);
 
 namespace {
 

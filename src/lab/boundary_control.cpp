@@ -1,0 +1,145 @@
+#include "lab/boundary_control.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "core/errors.hpp"
+#include "lab/measurements.hpp"
+
+namespace grainlab::lab {
+
+BoundaryControl::BoundaryControl(Simulation& sim) : sim_(sim) {
+  lengths0_ = sampleLengths(sim);
+  volume0_ = sim.volume();
+}
+
+void BoundaryControl::checkAxis(int axis) {
+  if (axis < 0 || axis > 2) throw std::invalid_argument(fmt::format("axis = {}; allowed: 0 (x), 1 (y), 2 (z)", axis));
+}
+
+Vec3 BoundaryControl::strain() const {
+  const Vec3 l = lengths();
+  return {(lengths0_[0] - l[0]) / lengths0_[0], (lengths0_[1] - l[1]) / lengths0_[1], (lengths0_[2] - l[2]) / lengths0_[2]};
+}
+
+namespace {
+
+class WallBoundary final : public BoundaryControl {
+ public:
+  explicit WallBoundary(Simulation& sim) : BoundaryControl(sim) {}
+  void holdStress(int axis, double target) override {
+    checkAxis(axis);
+    for (int side = 0; side < 2; ++side) holdFaceStress(axis, side, target);
+  }
+  void holdFaceStress(int axis, int side, double target) override {
+    checkAxis(axis);
+    if (side != 0 && side != 1) throw std::invalid_argument(fmt::format("side = {}; allowed: 0 (lower), 1 (upper)", side));
+    Wall& w = sim_.box.walls[WallBox::index(axis, side)];
+    w.control = WallControl::Stress;
+    w.targetStress = target;
+  }
+  void imposeStrainRate(int axis, double rate, double factor) override {
+    checkAxis(axis);
+    const double speed = factor * (0.5 * rate * lengths0_[axis]);
+    sim_.box.lower(axis).control = WallControl::Velocity;
+    sim_.box.upper(axis).control = WallControl::Velocity;
+    sim_.box.lower(axis).velocity = speed;
+    sim_.box.upper(axis).velocity = -speed;
+  }
+  void fix(int axis) override {
+    checkAxis(axis);
+    for (Wall* w : {&sim_.box.lower(axis), &sim_.box.upper(axis)}) {
+      w->control = WallControl::Fixed;
+      w->velocity = 0.0;
+    }
+  }
+  void constantVolume(int axis) override {
+    checkAxis(axis);
+    sim_.box.lower(axis).control = WallControl::ConstantVolume;
+    sim_.box.upper(axis).control = WallControl::ConstantVolume;
+    sim_.box.referenceVolume = sim_.box.volume();
+  }
+  void holdShape() override {}  // a box of walls keeps its principal axes
+  void freeShape() override {}
+  void imposeShearRate(double, double) override {
+    throw InputError("simple shear needs a periodic cell (test.boundary = \"periodic\"): a wall box has no shearing walls");
+  }
+  void setReference() override {
+    lengths0_ = lengths();
+    volume0_ = volume();
+  }
+  void beginTest() override { setReference(); }
+  Vec3 stress() const override { return {sim_.box.stress(0), sim_.box.stress(1), sim_.box.stress(2)}; }
+  std::array<double, 6> faceStresses() const override {
+    std::array<double, 6> s{};
+    for (int k = 0; k < 6; ++k) s[k] = sim_.box.wallStress(k);
+    return s;
+  }
+  Vec3 lengths() const override { return {sim_.box.length(0), sim_.box.length(1), sim_.box.length(2)}; }
+};
+
+class CellBoundary final : public BoundaryControl {
+ public:
+  explicit CellBoundary(Simulation& sim) : BoundaryControl(sim) {}
+  void holdStress(int axis, double target) override {
+    checkAxis(axis);
+    sim_.cell.control[axis] = CellControl::Stress;
+    sim_.cell.targetStress[axis] = target;
+  }
+  void holdFaceStress(int axis, int, double target) override { holdStress(axis, target); }
+  void imposeStrainRate(int axis, double rate, double factor) override {
+    checkAxis(axis);
+    sim_.cell.control[axis] = CellControl::StrainRate;
+    sim_.cell.strainRate[axis] = factor * rate;
+  }
+  void fix(int axis) override { imposeStrainRate(axis, 0.0, 1.0); }
+  void constantVolume(int axis) override {
+    checkAxis(axis);
+    sim_.cell.control[axis] = CellControl::ConstantVolume;
+  }
+  void holdShape() override {
+    for (int k = 0; k < 3; ++k) {
+      if (sim_.cell.shearControl[k] == CellControl::Stress) sim_.cell.shearServoIntegral[k] = 0.0;
+      sim_.cell.shearControl[k] = CellControl::StrainRate;
+    }
+  }
+  void freeShape() override {
+    for (int k = 0; k < 3; ++k) {
+      sim_.cell.shearControl[k] = CellControl::Stress;
+      sim_.cell.targetShearStress[k] = 0.0;
+    }
+    sim_.cell.shearRate = 0.0;
+  }
+  void imposeShearRate(double rate, double factor) override { sim_.cell.shearRate = factor * rate; }
+  void setReference() override {
+    lengths0_ = lengths();
+    volume0_ = volume();
+    sim_.cell.referenceLength = sim_.cell.h.diagonal();
+  }
+  void beginTest() override {
+    setReference();
+    sim_.cell.servoIntegral.setZero();
+  }
+  Vec3 stress() const override { return sim_.cell.stress.diagonal(); }
+  std::array<double, 6> faceStresses() const override {
+    std::array<double, 6> s{};
+    for (int k = 0; k < 6; ++k) s[k] = sim_.cell.stress(k / 2, k / 2);
+    return s;
+  }
+  Vec3 lengths() const override { return sim_.cell.h.diagonal(); }
+};
+
+}  // namespace
+
+std::unique_ptr<BoundaryControl> BoundaryControl::of(Simulation& sim) {
+  if (sim.boundary == Boundary::Periodic) return std::unique_ptr<BoundaryControl>(new CellBoundary(sim));
+  return std::unique_ptr<BoundaryControl>(new WallBoundary(sim));
+}
+
+void holdIsotropicStress(BoundaryControl& boundary, double pressure) {
+  for (int k = 0; k < 3; ++k) boundary.holdStress(k, pressure);
+  boundary.freeShape();
+}
+
+}  // namespace grainlab::lab

@@ -1,0 +1,48 @@
+#include "lab/protocol/shear_protocol.hpp"
+
+#include <cmath>
+
+#include "lab/protocols.hpp"
+
+namespace grainlab::lab {
+
+std::unique_ptr<ShearProtocol> makeTriaxial(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeConstantP(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeTrueTriaxial(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeSimpleShear(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeOedometer(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeCyclicTriaxial(const RunConfig& c);
+
+std::unique_ptr<ShearProtocol> ShearProtocol::make(const RunConfig& c) {
+  switch (c.test.type) {
+    case TestType::Triaxial: return makeTriaxial(c);
+    case TestType::ConstantP: return makeConstantP(c);
+    case TestType::TrueTriaxial: return makeTrueTriaxial(c);
+    case TestType::SimpleShear: return makeSimpleShear(c);
+    case TestType::Oedometer: return makeOedometer(c);
+    case TestType::CyclicTriaxial: return makeCyclicTriaxial(c);
+    case TestType::Isotropic: break;
+  }
+  throw std::logic_error("an isotropic test has no shearing protocol");
+}
+
+std::optional<double> ShearProtocol::givenRate() const {
+  return info().strain == DrivingStrain::Shear ? config_.test.shearStrainRate : config_.test.axialStrainRate;
+}
+
+void ShearProtocol::afterStep(const BoundaryControl& b) {
+  if (undrained()) trackUndrained(b);
+}
+
+void ShearProtocol::trackUndrained(const BoundaryControl& b) {
+  state.volumeDriftMax = std::max(state.volumeDriftMax, std::abs(b.volumetricStrain()));
+  state.ruMax = std::max(state.ruMax, poreRatio(b.stress()));
+}
+
+std::optional<Vec3> ShearProtocol::lateralTargets(double) const { return std::nullopt; }
+
+void ShearProtocol::completeRecord(Record& r) const {
+  if (undrained()) r.u = excessPorePressure(Vec3(r.sigma2, r.sigma3, r.sigma1));
+}
+
+}  // namespace grainlab::lab

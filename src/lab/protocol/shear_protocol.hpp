@@ -1,0 +1,94 @@
+#pragma once
+// A shearing test as a small object (one file each in lab/protocol/): it sets the boundary's
+// controls at the start, drives them before every step, keeps its own state, says how far the test
+// has gone and when it ends, and fills its own record columns. Laboratory::beginShear /
+// continueShear run every protocol the same way (records, snapshots, checkpoints, unload–reload
+// loops, progress) through BoundaryControl (lab/boundary_control.hpp).
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "lab/boundary_control.hpp"
+#include "lab/run_config.hpp"
+
+namespace grainlab::lab {
+
+struct Record;
+
+// What any protocol keeps between steps, in one plain struct so that a checkpoint writes it as its
+// bytes and the checkpoint's layout tag covers it (io/checkpoint_file.cpp).
+struct ProtocolState {
+  int direction = 1;            // oedometer, cyclic: +1 loading (compression), -1 unloading (extension)
+  double path = 0.0;            // oedometer, cyclic: accumulated |d eps1| since the start [-]
+  double lastEps1 = 0.0;        // axial strain at the previous step [-]
+  long halfCycles = 0;          // cyclic: reversals so far (two per cycle)
+  double cycleEpsMin = 0.0, cycleEpsMax = 0.0;  // cyclic: range of eps1 over the current cycle
+  double doubleAmplitude = 0.0; // cyclic: largest double-amplitude axial strain of a cycle so far
+  double ruMax = 0.0;           // undrained: largest ru = 1 - p'/p0 so far (every step)
+  double liquefiedCycles = -1.0;  // cyclic: cycles to liquefaction (-1: not liquefied)
+  double volumeDriftMax = 0.0;  // undrained: largest |eps_v| of any step
+  bool done = false;            // the protocol's own end (oedometer unloaded, cyclic stopped)
+  // Records the protocol asks for besides those spaced in progress(): at a reversal, and once the
+  // recorded quantity (oedometer: log10 sigma_v; cyclic: q) has moved by the protocol's step since
+  // the last record.
+  bool recordDue = false;
+  double lastRecorded = 0.0;
+};
+
+class ShearProtocol {
+ public:
+  explicit ShearProtocol(const RunConfig& config) : config_(config) {}
+  virtual ~ShearProtocol() = default;
+  // The protocol of config.test.type (not for "isotropic").
+  static std::unique_ptr<ShearProtocol> make(const RunConfig& config);
+
+  const TestTypeInfo& info() const { return lab::info(config_.test.type); }
+  bool undrained() const { return info().drainage && config_.test.drainage == Drainage::Undrained; }
+  // The strain rate the config gives (nullopt: "auto", from the inertial number).
+  std::optional<double> givenRate() const;
+  // The controls at the start of shearing (after BoundaryControl::beginTest).
+  virtual void configure(BoundaryControl& b) = 0;
+  // Before every step: the drive at `factor` of the loading rate `rate` (factor from the start-up
+  // ramp, an unload–reload loop or the platen slow-down).
+  virtual void drive(BoundaryControl& b, double rate, double factor) = 0;
+  // After every step.
+  virtual void afterStep(const BoundaryControl& b);
+  // The strain the test imposes: axial engineering strain since the start, or gamma.
+  virtual double strain(const BoundaryControl& b) const { return b.strain()[2]; }
+  // A variable that only grows, which records, snapshots and checkpoints are spaced in: the strain
+  // of monotonic tests, the accumulated |d eps1| of the reversing ones.
+  virtual double progress(const BoundaryControl& b) const { return strain(b); }
+  virtual bool finished(const BoundaryControl& b) const { return strain(b) >= config_.test.finalAxialStrain; }
+  virtual double fractionDone(const BoundaryControl& b) const {
+    return std::min(1.0, strain(b) / config_.test.finalAxialStrain);
+  }
+  // Lateral stress targets (x, y) the boundary is meant to hold, for how well it held them; none
+  // where the lateral axes are strain-controlled.
+  virtual std::optional<Vec3> lateralTargets(double sigma1) const;
+  // The protocol's own columns of a record (u, cycle).
+  virtual void completeRecord(Record& r) const;
+  // Whether the protocol wants a record after this step (ProtocolState::recordDue), and the record
+  // that was taken.
+  bool recordDue() const { return state.recordDue; }
+  virtual void recorded(const Record&) { state.recordDue = false; }
+  // "auto" rates of the reversing tests are this fraction of the inertial-number rate of the
+  // monotonic tests: an oedometer or a stress cycle of a stiff sand spans strains of 1e-5 to 1e-3,
+  // which the monotonic rate would cross in a few wave transit times of the sample.
+  static constexpr double kReversingRateFactor = 0.01;
+  virtual double autoRateFactor() const { return 1.0; }
+
+  ProtocolState state;
+
+ protected:
+  const RunConfig& config_;
+  // Excess pore pressure of an undrained test: the total lateral stress stays the cell pressure p0,
+  // the effective one is what the grains carry.
+  double excessPorePressure(const Vec3& sigma) const { return config_.test.confiningPressure - 0.5 * (sigma[0] + sigma[1]); }
+  void trackUndrained(const BoundaryControl& b);
+  // The excess pore-pressure ratio of the liquefaction criteria, ru = 1 - p'/p0: u less the q/3 of
+  // the total stress path (with the cell pressure held, p_total = p0 + q/3), the same as u/p0
+  // wherever q = 0.
+  double poreRatio(const Vec3& sigma) const { return 1.0 - (sigma.sum() / 3.0) / config_.test.confiningPressure; }
+};
+
+}  // namespace grainlab::lab

@@ -1,0 +1,150 @@
+"""The laboratory tests on the boundary-control seam (issue 24): undrained (constant-volume)
+triaxial on both boundaries, the oedometer and cyclic triaxial, end to end through the CLI on small
+soft samples. What each test's columns and summary say is recomputed here from its time series;
+resume after a kill is bit-identical; every new key's bad value exits 2 naming key, value and what
+is allowed. (Against analytic numbers: tests/unit/test_boundary_control.cpp, the FCC lattice.)"""
+import csv
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import GRAINLAB, kill_after_second_checkpoint
+
+DATA = os.path.join(os.path.dirname(__file__), "..", "data")
+CONFIG = os.path.join(DATA, "small-triaxial.toml")
+# Soft grains (Ec = 3e8 Pa): strains of the reversing tests are ~1e-2 instead of ~1e-4, and the
+# time step is larger, so each run takes seconds.
+SOFT = ["sample.n_particles=150", "contact.young=3e8", "output.plots=false", "output.vtk_every_strain=0"]
+
+
+def sets(*extra):
+    return [a for s in SOFT + list(extra) for a in ("--set", s)]
+
+
+def run(out, *extra, threads=1):
+    proc = subprocess.run([GRAINLAB, "run", CONFIG, "--out", str(out), "--quiet", "--threads", str(threads),
+                           *sets(*extra)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return read(out)
+
+
+def read(out):
+    with open(out / "timeseries.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    cols = {k: np.array([float(r[k]) if r[k] != "" else math.nan for r in rows]) for k in rows[0]}
+    return cols, json.loads((out / "summary.json").read_text())
+
+
+@pytest.mark.parametrize("boundary,allowed", [("walls", 1e-5), ("periodic", 1e-6)])
+def test_undrained_triaxial_holds_the_volume_and_reports_u(tmp_path, boundary, allowed):
+    c, s = run(tmp_path / "cu", 'test.drainage="undrained"', f'test.boundary="{boundary}"',
+               "test.final_axial_strain=0.02", "sample.e0_tolerance=1.0")
+    assert s["drainage"] == "undrained" and s["status"] == "completed"
+    p0 = s["confining_pressure"]
+    # u is the change of lateral total stress the constant volume needs: p0 - (sigma2 + sigma3)/2.
+    assert np.allclose(c["u"], p0 - 0.5 * (c["sigma2"] + c["sigma3"]), rtol=0, atol=1e-7 * p0)
+    assert np.abs(c["eps_v"]).max() < allowed and s["volume_drift_max"] < allowed
+    assert s["u_max"] == pytest.approx(c["u"].max()) and s["p_min"] == pytest.approx(c["p"].min())
+    # The axial strain was imposed while the lateral axes took it up: eps2 = eps3 < 0, sum ~ 0.
+    assert c["eps1"][-1] == pytest.approx(0.02, abs=1e-3)
+    assert c["eps2"][-1] < 0 and c["eps3"][-1] < 0
+    assert isinstance(s["liquefied"], bool)
+
+
+def test_oedometer_keeps_lateral_strain_zero_and_reports_k0(tmp_path):
+    c, s = run(tmp_path / "oed", 'test.type="oedometer"', "test.max_axial_stress=800e3", "test.unload_axial_stress=200e3",
+               "sample.e0_tolerance=1.0")
+    assert np.all(c["eps2"] == 0) and np.all(c["eps3"] == 0)
+    d = c["load_direction"]
+    assert d[0] == 1 and d[-1] == -1 and np.count_nonzero(np.diff(d)) == 1  # one reversal
+    assert c["sigma1"].max() >= 0.95 * 800e3 and c["sigma1"][-1] <= 1.1 * 200e3
+    # K0 recomputed by its definition: sigma_h/sigma_v over the loading records at or above
+    # sqrt(p0 sigma_v,max); Cc the least-squares slope of e on log10 sigma_v there.
+    p0, smax = s["confining_pressure"], c["sigma1"].max()
+    load = (d > 0) & (c["sigma1"] >= math.sqrt(p0 * smax))
+    k = 0.5 * (c["sigma2"] + c["sigma3"]) / c["sigma1"]
+    assert s["K0"] == pytest.approx(k[load].mean(), rel=1e-6)
+    assert s["Cc"] == pytest.approx(-np.polyfit(np.log10(c["sigma1"][load]), c["e"][load], 1)[0], rel=1e-4)
+    assert 0.2 < s["K0"] < 1.0 and s["Cc"] > 0 and s["Cs"] is not None
+    assert s["K0_unloading"] > s["K0"]  # unloading leaves a locked-in lateral stress
+    assert "phi_peak_deg" not in s and "cs_q_over_p" not in s
+
+
+@pytest.mark.parametrize("drainage", ["drained", "undrained"])
+def test_cyclic_triaxial_cycles_between_the_amplitudes(tmp_path, drainage):
+    c, s = run(tmp_path / "cyc", 'test.type="cyclic-triaxial"', f'test.drainage="{drainage}"', "test.csr=0.15",
+               "test.n_cycles=2", "sample.e0_tolerance=1.0")
+    qcyc = 2 * 0.15 * s["confining_pressure"]
+    assert s["cycles"] == 2.0 and c["cycle"][-1] == 2.0
+    # The reversal records (where `cycle` steps by a half) are at the amplitude, and q never leaves
+    # it by more than a step's worth.
+    steps = np.flatnonzero(np.diff(c["cycle"]) != 0) + 1
+    assert len(steps) == 4  # two reversals per cycle; the fourth ends the test
+    assert np.all(np.abs(c["q"][steps]) >= 0.9 * qcyc)
+    assert c["q"].max() < 1.2 * qcyc and c["q"].min() > -1.2 * qcyc
+    assert s["n_cycles_to_liquefaction"] is None
+    if drainage == "undrained":
+        assert s["ru_max"] > 0 and s["volume_drift_max"] < 1e-5
+        assert np.allclose(c["u"], s["confining_pressure"] - 0.5 * (c["sigma2"] + c["sigma3"]), atol=1e-2)
+    else:
+        assert s["ru_max"] is None and "u" not in c
+
+
+VOLATILE = {"wall_seconds", "particle_steps_per_s", "run_id"}
+
+
+@pytest.mark.parametrize("test", [
+    ['test.type="oedometer"', "test.max_axial_stress=800e3", "test.unload_axial_stress=200e3"],
+    ['test.type="cyclic-triaxial"', 'test.drainage="undrained"', "test.csr=0.15", "test.n_cycles=2"],
+    ['test.drainage="undrained"', "test.final_axial_strain=0.02"],
+])
+def test_kill_and_resume_is_bit_identical(tmp_path, test):
+    extra = test + ["sample.e0_tolerance=1.0", "output.checkpoint_every=1e-4"]
+    whole = tmp_path / "whole"
+    a = run(whole, *extra)
+    cut = tmp_path / "cut"
+    proc = subprocess.Popen([GRAINLAB, "run", CONFIG, "--out", str(cut), "--quiet", "--threads", "1", *sets(*extra)])
+    kill_after_second_checkpoint(proc, cut / "checkpoint" / "state.bin", timeout=300)
+    assert not (cut / "timeseries.csv").exists()
+    resumed = subprocess.run([GRAINLAB, "resume", str(cut), "--quiet"], capture_output=True, text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert (whole / "timeseries.csv").read_text() == (cut / "timeseries.csv").read_text()
+    sa = {k: v for k, v in a[1].items() if k not in VOLATILE}
+    sb = {k: v for k, v in json.loads((cut / "summary.json").read_text()).items() if k not in VOLATILE}
+    assert sa == sb
+
+
+@pytest.mark.parametrize("extra,key,words", [
+    (['test.drainage="partial"'], "test.drainage", ['"drained", "undrained"']),
+    (['test.type="oedometer"', "test.max_axial_stress=50e3"], "test.max_axial_stress", ["above test.confining_pressure"]),
+    (['test.type="oedometer"', "test.unload_axial_stress=2e6"], "test.unload_axial_stress", ["below test.max_axial_stress"]),
+    (['test.type="cyclic-triaxial"', "test.csr=0"], "test.csr", ["(0, 2]"]),
+    (['test.type="cyclic-triaxial"', "test.n_cycles=0"], "test.n_cycles", ["1"]),
+    (['test.type="cyclic-triaxial"', "test.ru_limit=1.5"], "test.ru_limit", ["(0, 1]"]),
+    (['test.type="cyclic-triaxial"', "test.liquefaction_da_strain=0.9"], "test.liquefaction_da_strain", ["(0, 0.5]"]),
+    (['test.type="stress-path"'], "test.type", ['"oedometer"', '"cyclic-triaxial"']),
+])
+def test_bad_input_of_the_new_tests_is_refused(tmp_path, extra, key, words):
+    proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets(*extra)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    line = proc.stderr.strip()
+    assert "\n" not in line and key in line, line
+    for w in words:
+        assert w in line, f"{w!r} not in {line}"
+
+
+@pytest.mark.parametrize("extra,key", [
+    (['test.type="oedometer"', 'test.drainage="undrained"'], "test.drainage"),
+    (["test.csr=0.2"], "test.csr"),
+    (['test.type="cyclic-triaxial"', "test.max_axial_stress=2e6"], "test.max_axial_stress"),
+])
+def test_keys_of_another_test_warn(extra, key):
+    """As for the other tests' keys (a config reused with --set test.type=...): ignored, with a
+    warning naming the key and the test type."""
+    proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets(*extra)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert f"warning: {key} = " in proc.stderr and "is ignored" in proc.stderr and "test.type" in proc.stderr

@@ -1,0 +1,85 @@
+// The macro-values of the undrained and oedometer tests (lab/test_report.hpp) against hand numbers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lab/test_report.hpp"
+
+using namespace grainlab;
+
+namespace {
+lab::Record rec(double eps1, double p, double q, double u) {
+  lab::Record r;
+  r.eps1 = eps1;
+  r.p = p;
+  r.q = q;
+  r.u = u;
+  return r;
+}
+}  // namespace
+
+// A loose sample's path: p' falls from 100 to 20 kPa, then rises; the phase transformation is the
+// minimum of p' (q = 30 kPa at eps1 = 2 %), u_max the largest u; liquefied only below (1 - ru) p0.
+TEST(LabReport, UndrainedPhaseTransformationAndLiquefaction) {
+  const std::vector<lab::Record> r{rec(0, 100e3, 0, 0), rec(0.01, 60e3, 50e3, 57e3), rec(0.02, 20e3, 30e3, 90e3),
+                                   rec(0.03, 40e3, 60e3, 80e3)};
+  const lab::UndrainedSummary s = lab::undrainedSummary(r, 100e3, 0.95, 3e-15);
+  EXPECT_EQ(s.uMax, 90e3);
+  EXPECT_EQ(s.pMin, 20e3);
+  ASSERT_TRUE(s.qAtPhaseTransformation);
+  EXPECT_EQ(*s.qAtPhaseTransformation, 30e3);
+  EXPECT_EQ(*s.eps1AtPhaseTransformation, 0.02);
+  EXPECT_FALSE(s.liquefied);  // 20 kPa > 5 kPa
+  EXPECT_EQ(s.volumeDriftMax, 3e-15);
+  EXPECT_TRUE(lab::undrainedSummary(r, 100e3, 0.8, 0.0).liquefied);  // 20 kPa <= (1 - 0.8) 100 kPa
+}
+
+// A dense sample whose p' only rises has no phase transformation (null, not the first record).
+TEST(LabReport, UndrainedDilativePathHasNoPhaseTransformation) {
+  const std::vector<lab::Record> r{rec(0, 100e3, 0, 0), rec(0.01, 150e3, 200e3, -20e3), rec(0.02, 300e3, 500e3, -80e3)};
+  const lab::UndrainedSummary s = lab::undrainedSummary(r, 100e3, 0.95, 0.0);
+  EXPECT_FALSE(s.qAtPhaseTransformation);
+  EXPECT_EQ(s.uMax, 0.0);
+}
+
+// An oedometer curve built from Cc = 0.05, Cs = 0.01 and K0 = 0.45 on loading: the summary recovers
+// them; K0 averages only the normally loaded part (sigma_v >= sqrt(p0 sigma_v,max)).
+TEST(LabReport, OedometerIndicesFromTheCurve) {
+  std::vector<lab::Record> r;
+  const double p0 = 100e3, smax = 1e6, e0 = 0.7;
+  for (int i = 0; i <= 20; ++i) {
+    lab::Record x;
+    x.sigma1 = p0 * std::pow(10.0, i / 20.0);
+    x.e = e0 - 0.05 * std::log10(x.sigma1 / p0);
+    const double k = x.sigma1 >= std::sqrt(p0 * smax) ? 0.45 : 1.0 - 0.55 * std::log10(x.sigma1 / p0) * 2.0;
+    x.sigma2 = x.sigma3 = k * x.sigma1;
+    x.loadDirection = 1;
+    r.push_back(x);
+  }
+  const double eMax = r.back().e;
+  for (int i = 1; i <= 10; ++i) {
+    lab::Record x;
+    x.sigma1 = smax * std::pow(10.0, -i / 10.0 * 0.7);
+    x.e = eMax + 0.01 * std::log10(smax / x.sigma1);
+    x.sigma2 = x.sigma3 = 0.8 * x.sigma1;
+    x.loadDirection = -1;
+    r.push_back(x);
+  }
+  const lab::OedometerSummary s = lab::oedometerSummary(r, p0);
+  ASSERT_TRUE(s.cc && s.cs && s.k0 && s.k0Unloading);
+  EXPECT_NEAR(*s.cc, 0.05, 1e-12);
+  EXPECT_NEAR(*s.cs, 0.01, 1e-12);
+  EXPECT_NEAR(*s.k0, 0.45, 1e-12);
+  EXPECT_NEAR(*s.k0Unloading, 0.8, 1e-12);
+  EXPECT_EQ(s.sigmaVMax, smax);
+  EXPECT_EQ(s.loadingRecords, 11u);
+}
+
+// Nothing to measure: no loading above p0 gives nulls, not zeros.
+TEST(LabReport, OedometerWithoutLoadingIsNull) {
+  lab::Record x;
+  x.sigma1 = 100e3;
+  const lab::OedometerSummary s = lab::oedometerSummary({x, x}, 100e3);
+  EXPECT_FALSE(s.cc);
+  EXPECT_FALSE(s.k0);
+}
