@@ -31,7 +31,7 @@ TEST(LabReport, UndrainedPhaseTransformationAndLiquefaction) {
   EXPECT_EQ(*s.eps1AtPhaseTransformation, 0.02);
   EXPECT_FALSE(s.liquefied);  // 20 kPa > 5 kPa
   EXPECT_EQ(s.volumeDriftMax, 3e-15);
-  EXPECT_TRUE(lab::undrainedSummary(r, 100e3, 0.8, 0.0).liquefied);  // 20 kPa <= (1 - 0.8) 100 kPa
+  EXPECT_TRUE(lab::undrainedSummary(r, 100e3, 0.75, 0.0).liquefied);  // 20 kPa <= (1 - 0.75) 100 kPa
 }
 
 // A dense sample whose p' only rises has no phase transformation (null, not the first record).
