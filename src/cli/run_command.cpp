@@ -490,11 +490,16 @@ class RunSession {
     summary_["eps1_at_phase_transformation"] =
         u.eps1AtPhaseTransformation ? json(*u.eps1AtPhaseTransformation) : json(nullptr);
     summary_["liquefied"] = u.liquefied;
-    summary_["volume_drift_max"] = u.volumeDriftMax;
+    volumeDriftKeys(u.volumeDriftMax);
+  }
+
+  // volume_drift_max of an undrained test, with a warning above what the boundary should hold.
+  void volumeDriftKeys(double drift) {
+    summary_["volume_drift_max"] = drift;
     const double allowed = config_.test.boundary == "periodic" ? 1e-6 : 1e-5;
-    if (u.volumeDriftMax > allowed)
-      summary_["warnings"].push_back(fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})",
-                                                 u.volumeDriftMax, allowed));
+    if (drift > allowed)
+      summary_["warnings"].push_back(
+          fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})", drift, allowed));
   }
 
   // Oedometer and cyclic triaxial: their own macro-values (lab/test_report.hpp), not a monotonic
@@ -525,15 +530,9 @@ class RunSession {
       summary_["liquefaction_criterion"] = fmt::format(
           "{}double-amplitude axial strain of a cycle >= {}; n_cycles_to_liquefaction counts the half cycle it "
           "happened in (0.5: the first compression)",
-          protocol.undrained() ? fmt::format("u/p0 >= {} or ", config_.test.ruLimit) : std::string(),
+          protocol.undrained() ? fmt::format("ru = 1 - p'/p0 >= {} or ", config_.test.ruLimit) : std::string(),
           config_.test.liquefactionDaStrain);
-      if (protocol.undrained()) {
-        summary_["volume_drift_max"] = protocol.state.volumeDriftMax;
-        const double allowed = config_.test.boundary == "periodic" ? 1e-6 : 1e-5;
-        if (protocol.state.volumeDriftMax > allowed)
-          summary_["warnings"].push_back(fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})",
-                                                     protocol.state.volumeDriftMax, allowed));
-      }
+      if (protocol.undrained()) volumeDriftKeys(protocol.state.volumeDriftMax);
     }
     summary_["strain_rate"] = shear.strainRate;
     summary_["inertial_number"] = shear.inertialNumber;

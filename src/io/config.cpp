@@ -898,7 +898,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                         "must be in (0, 2] (cyclic stress ratio q_cyc / (2 p0))");
   c.test.nCycles = t.integer("n_cycles", c.test.nCycles, 1, 100'000);
   c.test.ruLimit = t.number("ru_limit", c.test.ruLimit, 0.0, 1.0, true, false,
-                            "must be in (0, 1] (excess pore-pressure ratio u/p0 at liquefaction)");
+                            "must be in (0, 1] (excess pore-pressure ratio ru = 1 - p'/p0 at liquefaction)");
   c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
                                          "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
   t.finish();

@@ -255,8 +255,6 @@ class Laboratory {
   // sample.shape, in steps of eccentricity with the boundary holding p after each ([O] §5.2-5.3).
   long growShapes();
   double compactWithFriction(const Simulation& loose, double muDeg, Simulation& out, long& steps);
-  // Current strain of the test: axial strain, or gamma in simple shear.
-  double testStrain() const;
   void buildShearPipeline(Pipeline& pipeline);
 };
 

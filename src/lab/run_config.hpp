@@ -150,7 +150,7 @@ struct TestConfig {
   double maxAxialStress = 1.0e6;
   double unloadAxialStress = 100.0e3;
   // Cyclic triaxial: cyclic stress ratio q_cyc/(2 p0), the number of cycles at most, and the
-  // liquefaction criteria (excess pore-pressure ratio u/p0 and double-amplitude axial strain).
+  // liquefaction criteria (excess pore-pressure ratio ru = 1 - p'/p0 and double-amplitude axial strain).
   double csr = 0.2;
   long nCycles = 20;
   double ruLimit = 0.95;

@@ -15,12 +15,6 @@
 
 namespace grainlab::lab {
 
-double Laboratory::testStrain() const {
-  // Before shearing: the strain of the test that is to come, zero.
-  if (!protocol_) return 0.0;
-  return protocol_->strain(boundary());
-}
-
 Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const {
   Record r;
   r.step = sim_.stepCount;
