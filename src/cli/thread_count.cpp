@@ -110,7 +110,10 @@ ThreadChoice chooseThreads(int requested, bool adapt) {
       *others, *others == 1 ? "" : "s", cores, cores == 1 ? "" : "s", requested,
       keepRequested ? fmt::format("keeping {} threads as asked", requested)
                     : fmt::format("using {} thread{}", free, free == 1 ? "" : "s"),
-      keepRequested ? "" : "; GRAINLAB_KEEP_THREADS=1 keeps the requested count");
+      keepRequested ? (std::getenv("OMP_WAIT_POLICY") ? ""
+                                                      : "; OMP_WAIT_POLICY=PASSIVE makes the kept threads wait "
+                                                        "without spinning, which is much faster on busy cores")
+                    : "; GRAINLAB_KEEP_THREADS=1 keeps the requested count");
   return c;
 }
 

@@ -1,6 +1,11 @@
 """A run on a busy machine (issue 15): with fewer free cores than solver.threads, `grainlab run` runs
 on the free cores and says so on stderr; GRAINLAB_KEEP_THREADS=1 keeps the requested count. Busy
-cores are made by one spinning Python process per core."""
+cores are made by one spinning Python process per core.
+
+The runs that keep 2 threads on busy cores set OMP_WAIT_POLICY=PASSIVE: with libgomp's default
+spin-waiting, two OpenMP threads on cores shared with spinning hogs (and CI's other test jobs) meet
+at every barrier only when the scheduler happens to run both, which made a 100-sphere run take over
+5 minutes on the 2-core CI machine. Passive waiting changes the timing only, never the results."""
 import json
 import os
 import subprocess
@@ -37,8 +42,11 @@ def test_busy_cores_reduce_the_threads_with_a_warning(tmp_path, busy_cores):
     assert json.loads((tmp_path / "busy" / "summary.json").read_text())["threads"] == 2
 
 
+KEEP = {"GRAINLAB_KEEP_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}
+
+
 def test_keep_threads_only_warns(tmp_path, busy_cores):
-    proc = run(tmp_path, "kept", {"GRAINLAB_KEEP_THREADS": "1"})
+    proc = run(tmp_path, "kept", KEEP)
     assert proc.returncode == 0, proc.stderr
     assert "keeping 2 threads as asked" in proc.stderr, proc.stderr
 
@@ -46,6 +54,6 @@ def test_keep_threads_only_warns(tmp_path, busy_cores):
 def test_same_results_whatever_the_threads_chosen(tmp_path, busy_cores):
     busy = run(tmp_path, "busy")
     assert "using 1 thread" in busy.stderr
-    kept = run(tmp_path, "kept", {"GRAINLAB_KEEP_THREADS": "1"})
+    kept = run(tmp_path, "kept", KEEP)
     assert kept.returncode == 0
     assert (tmp_path / "busy" / "timeseries.csv").read_bytes() == (tmp_path / "kept" / "timeseries.csv").read_bytes()
