@@ -173,6 +173,29 @@ def laboratory_plots(data, summary, out, title):
         fig.tight_layout()
         save(fig, os.path.join(out, "oedometer.png"))
         return
+    if test == "stress-path" and "s" in data:
+        fig, (ax, axs, axe) = plt.subplots(1, 3, figsize=(15.5, 4.2))
+        ax.plot(kpa("p"), kpa("q"), ".-", ms=2, lw=1.1)
+        ax.set_xlabel("mean effective stress p' [kPa]")
+        ax.set_ylabel("deviator q [kPa]")
+        ax.set_xlim(left=0.0)
+        for key, label in (("sigma2", "sigma_xx"), ("sigma3", "sigma_yy"), ("sigma1", "sigma_zz")):
+            axs.plot(data["s"], kpa(key), lw=1.0, label=label)
+        axs.set_xlabel("path variable s")
+        axs.set_ylabel("normal stress [kPa]")
+        for key, label in (("eps2", "eps_xx"), ("eps3", "eps_yy"), ("eps1", "eps_zz"), ("eps_v", "eps_v")):
+            axe.plot(data["s"], [100.0 * v for v in data[key]], lw=1.0, label=label)
+        axe.set_xlabel("path variable s")
+        axe.set_ylabel("strain [%] (compression positive)")
+        for a in (ax, axs, axe):
+            a.grid(alpha=0.3)
+        axs.legend(fontsize=8)
+        axe.legend(fontsize=8)
+        ax.set_title("completed" if summary.get("path_completed") else "stopped before the end of the path", fontsize=9)
+        fig.suptitle(title + " - stress path", fontsize=10)
+        fig.tight_layout()
+        save(fig, os.path.join(out, "stress_path.png"))
+        return
     if "u" not in data and test != "cyclic-triaxial":
         return
     cyclic = test == "cyclic-triaxial"

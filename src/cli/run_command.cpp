@@ -368,7 +368,8 @@ class RunSession {
     lab::ShearResult shear = lab_.continueShear();
     progress_.finish();
     const std::vector<lab::Record>& records = shear.records;
-    if (config_.test.type == lab::TestType::Oedometer || config_.test.type == lab::TestType::CyclicTriaxial)
+    if (config_.test.type == lab::TestType::Oedometer || config_.test.type == lab::TestType::CyclicTriaxial ||
+        config_.test.type == lab::TestType::StressPath)
       return finishReversing(shear);
     const bool simpleShear = config_.test.type == lab::TestType::SimpleShear;
     lab::TriaxialCurves curves;
@@ -520,6 +521,23 @@ class RunSession {
           "sigma_v_max) (the start is isotropic), K0_unloading at the last record; Cc, Cs = -de/dlog10(sigma_v), "
           "least-squares over the same loading records and over the {} unloading records",
           o.loadingRecords, o.unloadingRecords);
+    } else if (config_.test.type == lab::TestType::StressPath) {
+      const lab::ProtocolState& ps = protocol.state;
+      const double sEnd = config_.test.path.back().s;
+      summary_["path_points"] = config_.test.path.size();
+      summary_["path_source"] = config_.test.pathSource.empty() ? json(nullptr) : json(config_.test.pathSource);
+      summary_["path_completed"] = !ps.pathFailed;
+      summary_["path_s_reached"] = ps.path;
+      summary_["path_stress_deviation_max"] = ps.stressDeviationMax;
+      summary_["path_method"] =
+          "s advances at test.axial_strain_rate; per segment each axis moves linearly in s from where the segment "
+          "began to the point's target; path_stress_deviation_max = max |sigma - target| / test.confining_pressure "
+          "of a stress-controlled axis over every step (the servo's lag)";
+      if (ps.pathFailed)
+        summary_["warnings"].push_back(fmt::format(
+            "the stress path stopped at s = {:.6g} of {:.6g}: a strain reached test.final_axial_strain = {} (a stress "
+            "target beyond what the sample carries)",
+            ps.path, sEnd, config_.test.finalAxialStrain));
     } else {
       const lab::CyclicSummary c = lab::cyclicSummary(protocol.state);
       summary_["n_cycles_to_liquefaction"] = c.cyclesToLiquefaction ? json(*c.cyclesToLiquefaction) : json(nullptr);

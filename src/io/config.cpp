@@ -203,7 +203,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
         "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
-        "n_cycles", "ru_limit", "liquefaction_da_strain"}},
+        "n_cycles", "ru_limit", "liquefaction_da_strain", "path"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
@@ -213,6 +213,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"sample.grading", {"type", "diameters", "passing", "d_min", "d_max", "file"}},
       {"sample.shape", {"type", "elongation", "flatness", "orientation", "fraction", "eccentricity_step"}},
       {"contact.sphericity", {"file", "c", "k", "combine"}},
+      {"test.path", {"file", "points", "controls", "source"}},
   };
   return keys;
 }
@@ -531,10 +532,13 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   if (key == "test.b" && type != "true-triaxial")
     return "only used with test.type = \"true-triaxial\"; " + here("test.type", type);
   if (key == "test.axial_strain_rate" && lab::info(tt).strain != lab::DrivingStrain::Axial)
-    return "only used with test.type = \"triaxial\", \"constant-p\", \"true-triaxial\", \"oedometer\" or "
-           "\"cyclic-triaxial\"; " + here("test.type", type);
-  if (key == "test.final_axial_strain" && !monotonicAxial)
-    return "only used with test.type = \"triaxial\", \"constant-p\" or \"true-triaxial\"; " + here("test.type", type);
+    return "only used with test.type = \"triaxial\", \"constant-p\", \"true-triaxial\", \"oedometer\", "
+           "\"cyclic-triaxial\" or \"stress-path\"; " + here("test.type", type);
+  if (key == "test.final_axial_strain" && !monotonicAxial && tt != lab::TestType::StressPath)
+    return "only used with test.type = \"triaxial\", \"constant-p\", \"true-triaxial\" or \"stress-path\"; " +
+           here("test.type", type);
+  if (key == "test.path" && tt != lab::TestType::StressPath)
+    return "only used with test.type = \"stress-path\"; " + here("test.type", type);
   if (key == "test.cs_window" && !monotonicAxial && tt != lab::TestType::SimpleShear)
     return "only used with the monotonic shearing tests (test.type = \"triaxial\", \"constant-p\", \"true-triaxial\" "
            "or \"simple-shear\"); " + here("test.type", type);
@@ -590,7 +594,7 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
           "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
           "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window",
           "test.drainage", "test.max_axial_stress", "test.unload_axial_stress", "test.csr", "test.n_cycles",
-          "test.ru_limit", "test.liquefaction_da_strain"};
+          "test.ru_limit", "test.liquefaction_da_strain", "test.path"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
           otherTestsKey) {
@@ -637,7 +641,8 @@ toml::table loadConfigTable(const std::string& source) {
 namespace {
 // The keys that name input files.
 bool isPathKey(const std::string& key) {
-  return key == "sample.packing" || key == "sample.grading.file" || key == "contact.sphericity.file";
+  return key == "sample.packing" || key == "sample.grading.file" || key == "contact.sphericity.file" ||
+         key == "test.path.file";
 }
 // A relative path given with --set is relative to the working directory: made absolute here, before
 // the config's folder is applied to the config's own relative paths.
@@ -705,6 +710,69 @@ void setOutputDir(toml::table& table, const std::string& dir) {
   }
   if (!output->is_table()) throw InputError(fmt::format("config error: output = {}: must be a table", show(*output)));
   output->as_table()->insert_or_assign("dir", dir);
+}
+
+// test.path: { file = "path.csv" } (read and checked here, lab/stress_path.hpp), or the points
+// inline, { points = [[s, xx, yy, zz], ...], controls = [["stress", "stress", "strain"], ...] }, the
+// form config.resolved.toml keeps so that a resumed run follows the same path whatever became of
+// the file (source names it).
+void parseStressPath(const toml::node& node, const std::string& baseDir, bool mustExist, lab::TestConfig& test) {
+  const std::string key = "test.path";
+  if (!node.is_table())
+    fail(key, show(node), "must be an inline table { file = \"path.csv\" } or { points = [[s, xx, yy, zz], ...], "
+                          "controls = [[\"stress\", \"stress\", \"strain\"], ...] }");
+  const toml::table& t = *node.as_table();
+  const toml::node* file = t.get("file");
+  const toml::node* points = t.get("points");
+  const toml::node* controls = t.get("controls");
+  if (const toml::node* src = t.get("source")) {
+    if (!src->is_string()) fail(key + ".source", show(*src), "must be a string (the file the points came from)");
+    test.pathSource = src->value<std::string>().value();
+  }
+  if (file && points) fail(key + ".points", show(*points), "give either test.path.file or test.path.points, not both");
+  if (file) {
+    if (!file->is_string()) fail(key + ".file", show(*file), "must be a path to a CSV of path points");
+    const std::string path = resolvePath(file->value<std::string>().value(), baseDir);
+    test.pathSource = path;
+    if (!mustExist && !pathExists(path)) return;
+    if (!pathExists(path)) fail(key + ".file", show(*file), notFound(path));
+    test.path = lab::readStressPathFile(path, key + ".file");
+    return;
+  }
+  if (!points) fail(key, show(node), "needs file = \"path.csv\" (or points with controls)");
+  if (!points->is_array() || points->as_array()->empty())
+    fail(key + ".points", show(*points), "must be a non-empty array of [s, xx, yy, zz]");
+  if (!controls || !controls->is_array() || controls->as_array()->size() != points->as_array()->size())
+    fail(key + ".controls", controls ? show(*controls) : "(missing)",
+         "must be an array with one [xx, yy, zz] of \"stress\" or \"strain\" per point");
+  if (points->as_array()->size() > lab::kMaxPathPoints)
+    fail(key + ".points", fmt::format("({} points)", points->as_array()->size()),
+         fmt::format("at most {} points", lab::kMaxPathPoints));
+  for (std::size_t i = 0; i < points->as_array()->size(); ++i) {
+    const toml::node& pn = *points->as_array()->get(i);
+    const toml::node& cn = *controls->as_array()->get(i);
+    const std::string pk = fmt::format("{}.points[{}]", key, i), ck = fmt::format("{}.controls[{}]", key, i);
+    const toml::array* pa = pn.as_array();
+    if (!pa || pa->size() != 4) fail(pk, show(pn), "must be [s, xx, yy, zz] (four numbers)");
+    const toml::array* ca = cn.as_array();
+    if (!ca || ca->size() != 3) fail(ck, show(cn), "must be [xx, yy, zz], each \"stress\" or \"strain\"");
+    lab::PathPoint p;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const toml::node& e = *pa->get(k);
+      if (!e.is_number() || !std::isfinite(numberOf(e)) || subnormal(numberOf(e)))
+        fail(pk, show(pn), "must be four finite, normal numbers [s, xx, yy, zz]");
+      (k == 0 ? p.s : p.value[k - 1]) = numberOf(e);
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::optional<std::string> text = ca->get(k)->value<std::string>();
+      const std::optional<lab::PathControl> control = text ? lab::parseControl(*text) : std::nullopt;
+      if (!control) fail(ck, show(cn), "each control must be \"stress\" or \"strain\"");
+      p.control[k] = *control;
+    }
+    if (const std::string why = lab::checkPathPoint(p, test.path.empty() ? 0.0 : test.path.back().s); !why.empty())
+      fail(pk, show(pn), why);
+    test.path.push_back(p);
+  }
 }
 
 lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, bool inputFilesMustExist) {
@@ -901,6 +969,11 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                             "must be in (0, 1] (excess pore-pressure ratio ru = 1 - p'/p0 at liquefaction)");
   c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
                                          "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
+  if (const toml::node* n = t.raw("path")) parseStressPath(*n, baseDir, inputFilesMustExist, c.test);
+  if (c.test.type == lab::TestType::StressPath && c.test.path.empty() && c.test.pathSource.empty())
+    fail("test.path", "(missing)",
+         "test.type = \"stress-path\" needs its table: test.path = { file = \"path.csv\" } (docs/laboratory.md, "
+         "\"Stress paths\")");
   t.finish();
 
   Section so(root, "solver");
@@ -1043,6 +1116,17 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(test, "test", "n_cycles", c.test.nCycles);
   put(test, "test", "ru_limit", c.test.ruLimit);
   put(test, "test", "liquefaction_da_strain", c.test.liquefactionDaStrain);
+  if (!c.test.path.empty()) {
+    toml::array points, controls;
+    for (const lab::PathPoint& p : c.test.path) {
+      points.push_back(toml::array{p.s, p.value[0], p.value[1], p.value[2]});
+      controls.push_back(toml::array{std::string(lab::controlName(p.control[0])), std::string(lab::controlName(p.control[1])),
+                                     std::string(lab::controlName(p.control[2]))});
+    }
+    toml::table path{{"points", points}, {"controls", controls}};
+    if (!c.test.pathSource.empty()) path.insert("source", c.test.pathSource);
+    put(test, "test", "path", path);
+  }
   toml::table solver{{"viscous_damping", c.solver.viscousDamping},
                      {"dt_factor", c.solver.dtFactor},
                      {"threads", c.solver.threads},

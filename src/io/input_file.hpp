@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace grainlab::io {
 
@@ -39,6 +40,10 @@ std::string readInputFile(const std::filesystem::path& path, const std::string& 
 std::string readInputFile(const std::filesystem::path& path, const std::string& subject, std::uintmax_t maxBytes,
                           std::size_t headBytes,
                           const std::function<void(std::string_view head, std::uintmax_t size)>& vet);
+
+// The fields of one line of a CSV list file (no quoting: the files grainlab reads hold numbers and
+// words), each trimmed of spaces, tabs and a trailing carriage return.
+std::vector<std::string> splitCsvLine(const std::string& line);
 
 // Physical memory of this machine [bytes] (0 when the system does not say).
 std::uintmax_t physicalMemoryBytes();

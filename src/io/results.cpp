@@ -49,6 +49,7 @@ TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
   c.cyclic = config.test.type == lab::TestType::CyclicTriaxial;
   c.reversing = config.test.type == lab::TestType::Oedometer || c.cyclic;
   c.loops = !config.test.unloadReloadAt.empty();
+  c.stressPath = config.test.type == lab::TestType::StressPath;
   return c;
 }
 
@@ -66,6 +67,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   if (columns.undrained) s += ",u";
   if (columns.cyclic) s += ",cycle";
   if (columns.reversing) s += ",load_direction";
+  if (columns.stressPath) s += ",s,segment";
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -100,6 +102,10 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
     if (columns.undrained) put(r.step, r.u);
     if (columns.cyclic) put(r.step, r.cycle);
     if (columns.reversing) s += fmt::format(",{}", r.loadDirection);
+    if (columns.stressPath) {
+      put(r.step, r.pathS);
+      s += fmt::format(",{}", r.pathSegment);
+    }
     s += '\n';
   }
   return s;

@@ -26,6 +26,8 @@ struct TimeseriesColumns {
   // Undrained tests: u (excess pore pressure); cyclic tests: cycle; oedometer and cyclic tests:
   // load_direction (+1 loading, -1 unloading).
   bool undrained = false, cyclic = false, reversing = false;
+  // Stress paths: s and segment (Record::pathS, pathSegment).
+  bool stressPath = false;
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 

@@ -75,6 +75,10 @@ struct Record {
   // Cyclic tests: cycles completed (in halves); oedometer and cyclic: +1 loading, -1 unloading.
   double cycle = 0.0;
   long loadDirection = 1;
+  // Stress path: the progress variable s, and the point the path runs to (1-based; the number of
+  // points once the path is done).
+  double pathS = 0.0;
+  long pathSegment = 0;
 };
 
 struct EquilibriumState {

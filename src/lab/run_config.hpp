@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/servo_settings.hpp"
+#include "lab/stress_path.hpp"
 #include "lab/test_type.hpp"
 
 namespace grainlab::lab {
@@ -155,6 +156,9 @@ struct TestConfig {
   long nCycles = 20;
   double ruLimit = 0.95;
   double liquefactionDaStrain = 0.05;
+  // Stress path (test.path): its points, and the file they were read from ("" when given inline).
+  std::vector<PathPoint> path;
+  std::string pathSource;
 };
 
 struct SolverConfig {

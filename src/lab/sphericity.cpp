@@ -11,22 +11,6 @@
 
 namespace grainlab::lab {
 
-namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string field;
-  while (std::getline(ss, field, ',')) {
-    const auto b = field.find_first_not_of(" \t\r");
-    const auto e = field.find_last_not_of(" \t\r");
-    out.push_back(b == std::string::npos ? "" : field.substr(b, e - b + 1));
-  }
-  return out;
-}
-
-}  // namespace
-
 SphericityDistribution readSphericityFile(const std::string& path, const std::string& key) {
   const std::string subject = fmt::format("config error: {} = {}", key, io::quotedPath(path));
   std::istringstream in(io::readInputFile(path, subject, io::kMaxListFileBytes));
@@ -38,7 +22,7 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++lineNo;
-    if (!line.empty() && line[0] != '#') header = splitCsv(line);
+    if (!line.empty() && line[0] != '#') header = io::splitCsvLine(line);
   }
   auto column = [&](const std::string& name) {
     const auto it = std::find(header.begin(), header.end(), name);
@@ -52,7 +36,7 @@ SphericityDistribution readSphericityFile(const std::string& path, const std::st
   while (std::getline(in, line)) {
     ++lineNo;
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r,") == std::string::npos) continue;
-    const std::vector<std::string> f = splitCsv(line);
+    const std::vector<std::string> f = io::splitCsvLine(line);
     auto number = [&](int col, const char* name) {
       if (col >= static_cast<int>(f.size())) throw fail(lineNo, fmt::format("missing {}", name));
       try {

@@ -203,12 +203,13 @@ def test_timeseries_columns_are_documented_in_order(short_run):
     # The columns of the other tests, where results.cpp inserts them: before energy_residual.
     src = read("src", "io", "results.cpp")
     extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
-    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops", "undrained", "cyclic", "reversing"}, extra
+    assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops", "undrained", "cyclic", "reversing",
+                          "stressPath"}, extra
     i = header.index("energy_residual")
     # The unload-reload column and the undrained, cyclic and reversing tests' columns come last,
     # after the micromechanics columns.
     expected = (header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")]
-                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing") for n in extra[k].split(",")])
+                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing", "stressPath") for n in extra[k].split(",")])
     rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
     documented = [n for cells in rows[2:] for n in names_in(cells[0])]
     assert documented == expected
@@ -226,6 +227,8 @@ SUMMARY_ONLY_SOMETIMES = {
     "K0", "K0_unloading", "Cc", "Cs", "sigma_v_max", "oedometer_method",
     # cyclic triaxial
     "n_cycles_to_liquefaction", "ru_max", "cycles", "double_amplitude_strain_max", "csr", "liquefaction_criterion",
+    # stress path
+    "path_points", "path_source", "path_completed", "path_s_reached", "path_stress_deviation_max", "path_method",
 }
 
 

@@ -12,6 +12,7 @@ std::unique_ptr<ShearProtocol> makeTrueTriaxial(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeSimpleShear(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeOedometer(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeCyclicTriaxial(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeStressPath(const RunConfig& c);
 
 std::unique_ptr<ShearProtocol> ShearProtocol::make(const RunConfig& c) {
   switch (c.test.type) {
@@ -21,6 +22,7 @@ std::unique_ptr<ShearProtocol> ShearProtocol::make(const RunConfig& c) {
     case TestType::SimpleShear: return makeSimpleShear(c);
     case TestType::Oedometer: return makeOedometer(c);
     case TestType::CyclicTriaxial: return makeCyclicTriaxial(c);
+    case TestType::StressPath: return makeStressPath(c);
     case TestType::Isotropic: break;
   }
   throw std::logic_error("an isotropic test has no shearing protocol");

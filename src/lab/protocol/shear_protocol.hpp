@@ -4,6 +4,7 @@
 // has gone and when it ends, and fills its own record columns. Laboratory::beginShear /
 // continueShear run every protocol the same way (records, snapshots, checkpoints, unload–reload
 // loops, progress) through BoundaryControl (lab/boundary_control.hpp).
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +34,15 @@ struct ProtocolState {
   // the last record.
   bool recordDue = false;
   double lastRecorded = 0.0;
+  // Stress path: the point the current segment runs to (== the number of points: the path is
+  // done), the value each axis's control starts the segment from, the targets of this step, the
+  // largest |stress - target| / p0 of a stress-controlled axis, and whether an axis reached
+  // test.final_axial_strain before the end (a stress target beyond the sample's strength).
+  long segment = 0;
+  std::array<double, 3> segmentStart{};
+  std::array<double, 3> target{};
+  double stressDeviationMax = 0.0;
+  bool pathFailed = false;
 };
 
 class ShearProtocol {
