@@ -173,6 +173,30 @@ def laboratory_plots(data, summary, out, title):
         fig.tight_layout()
         save(fig, os.path.join(out, "oedometer.png"))
         return
+    if test == "cyclic-simple-shear" and "gamma" in data:
+        fig, (ax, axg, axd) = plt.subplots(1, 3, figsize=(15.5, 4.2))
+        g0 = data["gamma"][0]
+        ax.plot([100.0 * (g - g0) for g in data["gamma"]], kpa("tau"), lw=0.8)
+        ax.set_xlabel("shear strain gamma - gamma0 [%]")
+        ax.set_ylabel("shear stress tau [kPa]")
+        amps = summary.get("shear_strain_amplitudes") or []
+        ratio = summary.get("G_over_Gmax") or []
+        damping = summary.get("damping_ratio") or []
+        if amps:
+            axg.semilogx(amps, [r if r is not None else float("nan") for r in ratio], "o-")
+            axd.semilogx(amps, [100.0 * d for d in damping], "s-")
+        axg.set_xlabel("shear strain amplitude gamma_a")
+        axg.set_ylabel("G / Gmax")
+        axg.set_ylim(0.0, 1.1)
+        axg.set_title("Gmax = {} MPa".format(fmt(summary.get("Gmax_MPa"))), fontsize=9)
+        axd.set_xlabel("shear strain amplitude gamma_a")
+        axd.set_ylabel("damping ratio [%]")
+        for a in (ax, axg, axd):
+            a.grid(alpha=0.3, which="both")
+        fig.suptitle(title + " - cyclic simple shear", fontsize=10)
+        fig.tight_layout()
+        save(fig, os.path.join(out, "cyclic_simple_shear.png"))
+        return
     if test == "stress-path" and "s" in data:
         fig, (ax, axs, axe) = plt.subplots(1, 3, figsize=(15.5, 4.2))
         ax.plot(kpa("p"), kpa("q"), ".-", ms=2, lw=1.1)

@@ -369,7 +369,7 @@ class RunSession {
     progress_.finish();
     const std::vector<lab::Record>& records = shear.records;
     if (config_.test.type == lab::TestType::Oedometer || config_.test.type == lab::TestType::CyclicTriaxial ||
-        config_.test.type == lab::TestType::StressPath)
+        config_.test.type == lab::TestType::StressPath || config_.test.type == lab::TestType::CyclicSimpleShear)
       return finishReversing(shear);
     const bool simpleShear = config_.test.type == lab::TestType::SimpleShear;
     lab::TriaxialCurves curves;
@@ -521,6 +521,37 @@ class RunSession {
           "sigma_v_max) (the start is isotropic), K0_unloading at the last record; Cc, Cs = -de/dlog10(sigma_v), "
           "least-squares over the same loading records and over the {} unloading records",
           o.loadingRecords, o.unloadingRecords);
+    } else if (config_.test.type == lab::TestType::CyclicSimpleShear) {
+      const lab::ProtocolState& ps = protocol.state;
+      const std::size_t n = static_cast<std::size_t>(ps.amplitudesDone);
+      json amplitudes = json::array(), g = json::array(), ratio = json::array(), damping = json::array();
+      // Gmax: the secant modulus at the smallest amplitude.
+      const double gmax = n > 0 ? ps.secantModulus[0] : 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        amplitudes.push_back(ps.measuredAmplitude[i]);
+        g.push_back(ps.secantModulus[i] / 1e6);
+        ratio.push_back(gmax > 0.0 ? json(ps.secantModulus[i] / gmax) : json(nullptr));
+        damping.push_back(ps.dampingRatio[i]);
+      }
+      summary_["shear_strain_amplitudes"] = amplitudes;
+      summary_["G_secant_MPa"] = g;
+      summary_["G_over_Gmax"] = ratio;
+      summary_["damping_ratio"] = damping;
+      summary_["Gmax_MPa"] = n > 0 ? json(gmax / 1e6) : json(nullptr);
+      summary_["cycles_per_amplitude"] = config_.test.cyclesPerAmplitude;
+      summary_["G_method"] = fmt::format(
+          "per amplitude, over its last of {} cycles: G = (tau_max - tau_min)/(gamma_max - gamma_min) (secant), "
+          "damping ratio = W_D/(4 pi W_S), W_D the loop area (integral of tau dgamma every step), W_S = G "
+          "gamma_a^2/2 with gamma_a the half-range of gamma; shear_strain_amplitudes are the measured half-ranges; "
+          "Gmax = G at the smallest amplitude",
+          config_.test.cyclesPerAmplitude);
+      if (n > 0 && config_.test.shearStrainAmplitudes[0] > 1e-5)
+        summary_["warnings"].push_back(fmt::format(
+            "the smallest amplitude {} is above 1e-5: Gmax (G at that amplitude) may be below the elastic "
+            "small-strain modulus",
+            config_.test.shearStrainAmplitudes[0]));
+      summary_["ru_max"] = protocol.undrained() ? json(ps.ruMax) : json(nullptr);
+      if (protocol.undrained()) volumeDriftKeys(ps.volumeDriftMax);
     } else if (config_.test.type == lab::TestType::StressPath) {
       const lab::ProtocolState& ps = protocol.state;
       const double sEnd = config_.test.path.back().s;

@@ -203,7 +203,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
         "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
-        "n_cycles", "ru_limit", "liquefaction_da_strain", "path"}},
+        "n_cycles", "ru_limit", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
@@ -542,10 +542,16 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   if (key == "test.cs_window" && !monotonicAxial && tt != lab::TestType::SimpleShear)
     return "only used with the monotonic shearing tests (test.type = \"triaxial\", \"constant-p\", \"true-triaxial\" "
            "or \"simple-shear\"); " + here("test.type", type);
-  if ((key == "test.shear_strain_rate" || key == "test.final_shear_strain") && tt != lab::TestType::SimpleShear)
+  if (key == "test.shear_strain_rate" && lab::info(tt).strain != lab::DrivingStrain::Shear)
+    return "only used with test.type = \"simple-shear\" or \"cyclic-simple-shear\"; " + here("test.type", type);
+  if (key == "test.final_shear_strain" && tt != lab::TestType::SimpleShear)
     return "only used with test.type = \"simple-shear\"; " + here("test.type", type);
+  if ((key == "test.shear_strain_amplitudes" || key == "test.cycles_per_amplitude") &&
+      tt != lab::TestType::CyclicSimpleShear)
+    return "only used with test.type = \"cyclic-simple-shear\"; " + here("test.type", type);
   if (key == "test.drainage" && !lab::info(tt).drainage)
-    return "only used with test.type = \"triaxial\", \"simple-shear\" or \"cyclic-triaxial\"; " + here("test.type", type);
+    return "only used with test.type = \"triaxial\", \"simple-shear\", \"cyclic-triaxial\" or \"cyclic-simple-shear\"; " +
+           here("test.type", type);
   if ((key == "test.max_axial_stress" || key == "test.unload_axial_stress") && tt != lab::TestType::Oedometer)
     return "only used with test.type = \"oedometer\"; " + here("test.type", type);
   if ((key == "test.csr" || key == "test.n_cycles" || key == "test.liquefaction_da_strain") && tt != lab::TestType::CyclicTriaxial)
@@ -594,7 +600,8 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
           "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
           "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window",
           "test.drainage", "test.max_axial_stress", "test.unload_axial_stress", "test.csr", "test.n_cycles",
-          "test.ru_limit", "test.liquefaction_da_strain", "test.path"};
+          "test.ru_limit", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
+          "test.cycles_per_amplitude"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
           otherTestsKey) {
@@ -970,6 +977,19 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
                                          "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
   if (const toml::node* n = t.raw("path")) parseStressPath(*n, baseDir, inputFilesMustExist, c.test);
+  if (const toml::node* n = t.raw("shear_strain_amplitudes")) {
+    const std::string key = t.path("shear_strain_amplitudes");
+    c.test.shearStrainAmplitudes = t.numbers(*n, key);
+    const auto& a = c.test.shearStrainAmplitudes;
+    if (a.empty() || a.size() > static_cast<std::size_t>(lab::kMaxShearAmplitudes))
+      fail(key, show(*n), fmt::format("must hold 1 to {} amplitudes", lab::kMaxShearAmplitudes));
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!(a[i] >= 1e-7 && a[i] <= 0.1))
+        fail(key, show(*n), "every amplitude must be a shear strain in [1e-7, 0.1]");
+      if (i > 0 && !(a[i] > a[i - 1])) fail(key, show(*n), "the amplitudes must be strictly increasing");
+    }
+  }
+  c.test.cyclesPerAmplitude = t.integer("cycles_per_amplitude", c.test.cyclesPerAmplitude, 1, 1000);
   if (c.test.type == lab::TestType::StressPath && c.test.path.empty() && c.test.pathSource.empty())
     fail("test.path", "(missing)",
          "test.type = \"stress-path\" needs its table: test.path = { file = \"path.csv\" } (docs/laboratory.md, "
@@ -1116,6 +1136,12 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(test, "test", "n_cycles", c.test.nCycles);
   put(test, "test", "ru_limit", c.test.ruLimit);
   put(test, "test", "liquefaction_da_strain", c.test.liquefactionDaStrain);
+  {
+    toml::array amplitudes;
+    for (double v : c.test.shearStrainAmplitudes) amplitudes.push_back(v);
+    put(test, "test", "shear_strain_amplitudes", amplitudes);
+  }
+  put(test, "test", "cycles_per_amplitude", c.test.cyclesPerAmplitude);
   if (!c.test.path.empty()) {
     toml::array points, controls;
     for (const lab::PathPoint& p : c.test.path) {

@@ -43,13 +43,14 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
   TimeseriesColumns c;
   c.periodic = config.test.boundary == "periodic";
-  c.simpleShear = config.test.type == lab::TestType::SimpleShear;
+  c.simpleShear = lab::info(config.test.type).strain == lab::DrivingStrain::Shear;
   c.trueTriaxial = config.test.type == lab::TestType::TrueTriaxial;
   c.undrained = lab::info(config.test.type).drainage && config.test.drainage == lab::Drainage::Undrained;
-  c.cyclic = config.test.type == lab::TestType::CyclicTriaxial;
+  c.cyclic = config.test.type == lab::TestType::CyclicTriaxial || config.test.type == lab::TestType::CyclicSimpleShear;
   c.reversing = config.test.type == lab::TestType::Oedometer || c.cyclic;
   c.loops = !config.test.unloadReloadAt.empty();
   c.stressPath = config.test.type == lab::TestType::StressPath;
+  c.cyclicShear = config.test.type == lab::TestType::CyclicSimpleShear;
   return c;
 }
 
@@ -68,6 +69,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   if (columns.cyclic) s += ",cycle";
   if (columns.reversing) s += ",load_direction";
   if (columns.stressPath) s += ",s,segment";
+  if (columns.cyclicShear) s += ",amplitude";
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -106,6 +108,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
       put(r.step, r.pathS);
       s += fmt::format(",{}", r.pathSegment);
     }
+    if (columns.cyclicShear) s += fmt::format(",{}", r.pathSegment);
     s += '\n';
   }
   return s;

@@ -28,6 +28,8 @@ struct TimeseriesColumns {
   bool undrained = false, cyclic = false, reversing = false;
   // Stress paths: s and segment (Record::pathS, pathSegment).
   bool stressPath = false;
+  // Cyclic simple shear: amplitude (1-based index into test.shear_strain_amplitudes).
+  bool cyclicShear = false;
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 

@@ -53,7 +53,9 @@ void checkTestSteps(const RunConfig& c, const Simulation& sim, double d50) {
   const TestConfig& t = c.test;
   // The oedometer's and the cyclic tests' lengths follow from the sample's response (where the stress
   // reaches its target, when it liquefies), not from a final strain: solver.max_steps guards them.
-  if (t.type == TestType::Isotropic || t.type == TestType::Oedometer || t.type == TestType::CyclicTriaxial) return;
+  if (t.type == TestType::Isotropic || t.type == TestType::Oedometer || t.type == TestType::CyclicTriaxial ||
+      t.type == TestType::CyclicSimpleShear || t.type == TestType::StressPath)
+    return;
   const bool shear = t.type == TestType::SimpleShear;
   const std::optional<double> given = shear ? t.shearStrainRate : t.axialStrainRate;
   const double rate = given.value_or(Laboratory::kAutoInertialNumber / (d50 * std::sqrt(c.sample.density / t.confiningPressure)));

@@ -18,6 +18,10 @@ namespace grainlab::lab {
 inline constexpr double kMinDiameter = 1e-6;
 inline constexpr double kMaxDiameter = 10.0;
 
+// Most shear strain amplitudes of a cyclic simple shear test (their results live in the
+// protocol's fixed-size, checkpointed state).
+inline constexpr int kMaxShearAmplitudes = 16;
+
 struct GradingConfig {
   // "curve" (percent passing by mass), "uniform" (by number), "list"; "packing": the grading of
   // sample.packing, as config.resolved.toml records a run from a packing file
@@ -159,6 +163,10 @@ struct TestConfig {
   // Stress path (test.path): its points, and the file they were read from ("" when given inline).
   std::vector<PathPoint> path;
   std::string pathSource;
+  // Cyclic simple shear: the shear strain amplitudes, increasing (at most kMaxShearAmplitudes),
+  // each cycled this many times.
+  std::vector<double> shearStrainAmplitudes{1e-5, 1e-4, 1e-3};
+  long cyclesPerAmplitude = 2;
 };
 
 struct SolverConfig {

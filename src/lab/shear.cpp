@@ -64,7 +64,7 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
     r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);
     r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
     r.tau = meanStress ? meanShearStress : -0.5 * (sc(0, 2) + sc(2, 0));
-    if (t.type == TestType::SimpleShear) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
+    if (info(t.type).strain == DrivingStrain::Shear) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
   }
   const GrainKinematics k = currentKinematics();
   r.rotationMeanDeg = k.rotationMeanDeg;

@@ -16,6 +16,7 @@ enum class TestType : std::uint8_t {
   Oedometer,      // axial loading and unloading with no lateral strain
   CyclicTriaxial, // deviator cycles of amplitude 2 csr p0 about the isotropic state
   StressPath,     // a table of stress or strain targets per axis (test.path, lab/stress_path.hpp)
+  CyclicSimpleShear,  // periodic cell: gamma cycles at a list of amplitudes, G and damping per amplitude
 };
 
 // What the shearing part of a test is driven by: the axial strain (platens or H_zz) or the shear
@@ -31,7 +32,7 @@ struct TestTypeInfo {
   bool drainage;           // test.drainage = "undrained" applies
 };
 
-inline constexpr std::array<TestTypeInfo, 8> kTestTypes{{
+inline constexpr std::array<TestTypeInfo, 9> kTestTypes{{
     {TestType::Isotropic, "isotropic", "isotropic consolidation", DrivingStrain::None, false, false},
     {TestType::Triaxial, "triaxial", "triaxial shearing", DrivingStrain::Axial, false, true},
     {TestType::ConstantP, "constant-p", "constant-p", DrivingStrain::Axial, false, false},
@@ -40,6 +41,7 @@ inline constexpr std::array<TestTypeInfo, 8> kTestTypes{{
     {TestType::Oedometer, "oedometer", "oedometer", DrivingStrain::Axial, false, false},
     {TestType::CyclicTriaxial, "cyclic-triaxial", "cyclic triaxial", DrivingStrain::Axial, false, true},
     {TestType::StressPath, "stress-path", "stress path", DrivingStrain::Axial, false, false},
+    {TestType::CyclicSimpleShear, "cyclic-simple-shear", "cyclic simple shear", DrivingStrain::Shear, true, true},
 }};
 
 inline const TestTypeInfo& info(TestType t) {

@@ -118,6 +118,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "simple-shear": '[test]\ntype = "simple-shear"\nboundary = "periodic"\n',
         "oedometer": '[test]\ntype = "oedometer"\n',
         "cyclic-triaxial": '[test]\ntype = "cyclic-triaxial"\n',
+        "cyclic-simple-shear": '[test]\ntype = "cyclic-simple-shear"\nboundary = "periodic"\n',
         "dt": '[solver]\ndt = 1e-7\n',
     }
     printed = {}
@@ -204,12 +205,12 @@ def test_timeseries_columns_are_documented_in_order(short_run):
     src = read("src", "io", "results.cpp")
     extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
     assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops", "undrained", "cyclic", "reversing",
-                          "stressPath"}, extra
+                          "stressPath", "cyclicShear"}, extra
     i = header.index("energy_residual")
     # The unload-reload column and the undrained, cyclic and reversing tests' columns come last,
     # after the micromechanics columns.
     expected = (header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")]
-                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing", "stressPath") for n in extra[k].split(",")])
+                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing", "stressPath", "cyclicShear") for n in extra[k].split(",")])
     rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
     documented = [n for cells in rows[2:] for n in names_in(cells[0])]
     assert documented == expected
@@ -227,6 +228,9 @@ SUMMARY_ONLY_SOMETIMES = {
     "K0", "K0_unloading", "Cc", "Cs", "sigma_v_max", "oedometer_method",
     # cyclic triaxial
     "n_cycles_to_liquefaction", "ru_max", "cycles", "double_amplitude_strain_max", "csr", "liquefaction_criterion",
+    # cyclic simple shear
+    "shear_strain_amplitudes", "G_secant_MPa", "G_over_Gmax", "damping_ratio", "Gmax_MPa", "cycles_per_amplitude",
+    "G_method",
     # stress path
     "path_points", "path_source", "path_completed", "path_s_reached", "path_stress_deviation_max", "path_method",
 }

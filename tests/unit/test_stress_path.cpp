@@ -212,3 +212,31 @@ TEST(StressPathFile, EveryDefectNamesTheLineAndWhatIsAllowed) {
   EXPECT_NE(errorOf(header + "0.01,1e5,stress\n").find("missing yy"), std::string::npos);
   EXPECT_NE(errorOf(header + "0,1e5,stress,1e5,stress,1e5,stress\n").find("s = 0 must be"), std::string::npos);
 }
+
+// Cyclic simple shear (lab/protocol/cyclic_simple_shear.cpp) on the same lattice at constant
+// volume: a central-force FCC crystal sheared in xz has the shear modulus C44 = kn/a (the Cauchy
+// relation C44 = C12), the same at every small amplitude, and an elastic loop encloses no area
+// (damping ratio ~0: only the local damping of the small velocities acts).
+TEST(CyclicSimpleShear, ElasticLatticeGivesC44AndNoDamping) {
+  Lattice l = fcc(3, 1e-3);
+  auto b = lab::BoundaryControl::of(l.sim);
+  l.sim.step();
+  b->beginTest();
+  lab::RunConfig c;
+  c.test.type = lab::TestType::CyclicSimpleShear;
+  c.test.drainage = lab::Drainage::Undrained;
+  c.test.confiningPressure = b->stress()[2];
+  c.test.shearStrainAmplitudes = {1e-5, 1e-4};
+  c.test.cyclesPerAmplitude = 1;
+  auto p = lab::ShearProtocol::make(c);
+  runPath(l.sim, *b, *p, 1.0, [] {});
+  const lab::ProtocolState& s = p->state;
+  ASSERT_EQ(s.amplitudesDone, 2);
+  const double c44 = l.kn / l.a;
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(s.measuredAmplitude[i], c.test.shearStrainAmplitudes[i], 0.01 * c.test.shearStrainAmplitudes[i]);
+    EXPECT_NEAR(s.secantModulus[i], c44, 0.02 * c44) << i;
+    EXPECT_LT(std::abs(s.dampingRatio[i]), 0.01) << i;
+  }
+  EXPECT_LT(s.volumeDriftMax, 1e-12);
+}

@@ -13,6 +13,7 @@ std::unique_ptr<ShearProtocol> makeSimpleShear(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeOedometer(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeCyclicTriaxial(const RunConfig& c);
 std::unique_ptr<ShearProtocol> makeStressPath(const RunConfig& c);
+std::unique_ptr<ShearProtocol> makeCyclicSimpleShear(const RunConfig& c);
 
 std::unique_ptr<ShearProtocol> ShearProtocol::make(const RunConfig& c) {
   switch (c.test.type) {
@@ -23,6 +24,7 @@ std::unique_ptr<ShearProtocol> ShearProtocol::make(const RunConfig& c) {
     case TestType::Oedometer: return makeOedometer(c);
     case TestType::CyclicTriaxial: return makeCyclicTriaxial(c);
     case TestType::StressPath: return makeStressPath(c);
+    case TestType::CyclicSimpleShear: return makeCyclicSimpleShear(c);
     case TestType::Isotropic: break;
   }
   throw std::logic_error("an isotropic test has no shearing protocol");

@@ -43,6 +43,19 @@ struct ProtocolState {
   std::array<double, 3> target{};
   double stressDeviationMax = 0.0;
   bool pathFailed = false;
+  // Cyclic simple shear: gamma at the start (a prepared cell is slightly skewed; amplitudes are
+  // measured from there), the amplitude being cycled (index into test.shear_strain_amplitudes),
+  // gamma and tau of the previous step, and of the current cycle its ranges and the loop area
+  // (the work per unit volume, the integral of tau dgamma); per amplitude the secant modulus, the
+  // damping ratio and the half-range of gamma of the last cycle.
+  static constexpr int kMaxAmplitudes = kMaxShearAmplitudes;
+  double gamma0 = 0.0;
+  long amplitude = 0;
+  bool returning = false;  // after the last cycle of an amplitude: back to gamma0
+  double lastGamma = 0.0, lastTau = 0.0;
+  double cycleGammaMin = 0.0, cycleGammaMax = 0.0, cycleTauMin = 0.0, cycleTauMax = 0.0, loopArea = 0.0;
+  std::array<double, kMaxAmplitudes> secantModulus{}, dampingRatio{}, measuredAmplitude{};
+  long amplitudesDone = 0;
 };
 
 class ShearProtocol {
