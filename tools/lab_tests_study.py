@@ -100,124 +100,129 @@ def report(a):
             missing.append(name)
     lines = []
     # Undrained triaxial.
-    lines.append("| sample | seed | e0 | p′ min [kPa] | u max [kPa] | q at PT [kPa] | ε1 at PT [%] | liquefied | "
-                 "p′ end [kPa] | q end [kPa] | volume drift max | wall [s] |")
-    lines.append("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|")
-    fig, (ax, axu) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != "cu":
-            continue
-        pt_q, pt_e = s.get("q_at_phase_transformation"), s.get("eps1_at_phase_transformation")
-        lines.append(f"| {preset.split('-')[1]} | {s['seed']} | {s['e0']:.3f} | {s['p_min'] / 1e3:.1f} | "
-                     f"{s['u_max'] / 1e3:.1f} | {fmt(pt_q / 1e3 if pt_q is not None else None)} | "
-                     f"{fmt(100 * pt_e if pt_e is not None else None)} | {fmt(s['liquefied'])} | "
-                     f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
-                     f"{s['wall_seconds']:.0f} |")
-        colour = "tab:red" if "loose" in preset else "tab:blue"
-        ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], color=colour, lw=0.9,
-                label=f"{preset.split('-')[1]} s{s['seed']}")
-        axu.plot([100 * e for e in d["eps1"]], [u / s["confining_pressure"] for u in d["u"]], color=colour, lw=0.9)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("p′ [kPa] (log)")
-    ax.set_ylabel("q [kPa] (log)")
-    ax.legend(fontsize=7)
-    axu.set_xlabel("axial strain ε1 [%]")
-    axu.set_ylabel("u / p0")
-    axu.set_yscale("symlog", linthresh=1.0)
-    for x in (ax, axu):
-        x.grid(alpha=0.3, which="both")
-    fig.suptitle("Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "undrained.png"), dpi=110)
-    plt.close(fig)
-    write_table(os.path.join(out_dir, "undrained-table.md"), lines)
+    if "cu" in a.only:
+        lines.append("| sample | seed | e0 | p′ min [kPa] | u max [kPa] | q at PT [kPa] | ε1 at PT [%] | liquefied | "
+                     "p′ end [kPa] | q end [kPa] | volume drift max | wall [s] |")
+        lines.append("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|")
+        fig, (ax, axu) = plt.subplots(1, 2, figsize=(11, 4.2))
+        for name, (g, preset, s, d) in sorted(done.items()):
+            if g != "cu":
+                continue
+            pt_q, pt_e = s.get("q_at_phase_transformation"), s.get("eps1_at_phase_transformation")
+            lines.append(f"| {preset.split('-')[1]} | {s['seed']} | {s['e0']:.3f} | {s['p_min'] / 1e3:.1f} | "
+                         f"{s['u_max'] / 1e3:.1f} | {fmt(pt_q / 1e3 if pt_q is not None else None)} | "
+                         f"{fmt(100 * pt_e if pt_e is not None else None)} | {fmt(s['liquefied'])} | "
+                         f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
+                         f"{s['wall_seconds']:.0f} |")
+            colour = "tab:red" if "loose" in preset else "tab:blue"
+            ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], color=colour, lw=0.9,
+                    label=f"{preset.split('-')[1]} s{s['seed']}")
+            axu.plot([100 * e for e in d["eps1"]], [u / s["confining_pressure"] for u in d["u"]], color=colour, lw=0.9)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("p′ [kPa] (log)")
+        ax.set_ylabel("q [kPa] (log)")
+        ax.legend(fontsize=7)
+        axu.set_xlabel("axial strain ε1 [%]")
+        axu.set_ylabel("u / p0")
+        axu.set_yscale("symlog", linthresh=1.0)
+        for x in (ax, axu):
+            x.grid(alpha=0.3, which="both")
+        fig.suptitle("Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)", fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "undrained.png"), dpi=110)
+        plt.close(fig)
+        write_table(os.path.join(out_dir, "undrained-table.md"), lines)
     # Oedometer.
-    lines = ["| seed | e0 | K0 | K0 unloading | Cc | Cs | σv max [kPa] | wall [s] |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    k0s, fig = [], plt.figure(figsize=(5.5, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != "oedometer":
-            continue
-        k0s.append(s["K0"])
-        lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['K0'])} | {fmt(s['K0_unloading'])} | {fmt(s['Cc'])} | "
-                     f"{fmt(s['Cs'])} | {s['sigma_v_max'] / 1e3:.0f} | {s['wall_seconds']:.0f} |")
-        plt.semilogx([v / 1e3 for v in d["sigma1"]], d["e"], lw=0.9, label=f"seed {s['seed']}")
-    plt.xlabel("σv [kPa] (log)")
-    plt.ylabel("void ratio e")
-    plt.grid(alpha=0.3, which="both")
-    plt.legend(fontsize=8)
-    plt.title("Oedometer, dense, from 200 kPa isotropic", fontsize=10)
-    plt.tight_layout()
-    plt.savefig(os.path.join(out_dir, "oedometer.png"), dpi=110)
-    plt.close()
-    lines.append("")
-    lines.append(f"K0 on loading over the seeds: {mean_sd(k0s)}")
-    write_table(os.path.join(out_dir, "oedometer-table.md"), lines)
+    if "oedometer" in a.only:
+        lines = ["| seed | e0 | K0 | K0 unloading | Cc | Cs | σv max [kPa] | wall [s] |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        k0s, fig = [], plt.figure(figsize=(5.5, 4.2))
+        for name, (g, preset, s, d) in sorted(done.items()):
+            if g != "oedometer":
+                continue
+            k0s.append(s["K0"])
+            lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['K0'])} | {fmt(s['K0_unloading'])} | {fmt(s['Cc'])} | "
+                         f"{fmt(s['Cs'])} | {s['sigma_v_max'] / 1e3:.0f} | {s['wall_seconds']:.0f} |")
+            plt.semilogx([v / 1e3 for v in d["sigma1"]], d["e"], lw=0.9, label=f"seed {s['seed']}")
+        plt.xlabel("σv [kPa] (log)")
+        plt.ylabel("void ratio e")
+        plt.grid(alpha=0.3, which="both")
+        plt.legend(fontsize=8)
+        plt.title("Oedometer, dense, from 200 kPa isotropic", fontsize=10)
+        plt.tight_layout()
+        plt.savefig(os.path.join(out_dir, "oedometer.png"), dpi=110)
+        plt.close()
+        lines.append("")
+        lines.append(f"K0 on loading over the seeds: {mean_sd(k0s)}")
+        write_table(os.path.join(out_dir, "oedometer-table.md"), lines)
     # Cyclic triaxial.
-    lines = ["| CSR | seed | e0 | N to liquefaction | ru max | DA strain max [%] | cycles run | volume drift max | wall [s] |",
-             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    fig = plt.figure(figsize=(5.5, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != "cyclic":
-            continue
-        n = s["n_cycles_to_liquefaction"]
-        lines.append(f"| {s['csr']:g} | {s['seed']} | {s['e0']:.3f} | {fmt(n)} | {fmt(s['ru_max'])} | "
-                     f"{100 * s['double_amplitude_strain_max']:.2f} | {s['cycles']:g} | {s['volume_drift_max']:.1e} | "
-                     f"{s['wall_seconds']:.0f} |")
-        if n is not None:
-            plt.semilogx([n], [s["csr"]], "o", color="tab:red")
-        else:
-            plt.semilogx([s["cycles"]], [s["csr"]], ">", color="tab:grey")
-    plt.xlabel("cycles to liquefaction N (grey ▶: not liquefied in the cycles run)")
-    plt.ylabel("CSR = q_cyc / (2 p0)")
-    plt.grid(alpha=0.3, which="both")
-    plt.title("Undrained cyclic triaxial, loose, p0 = 200 kPa", fontsize=10)
-    plt.tight_layout()
-    plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
-    plt.close()
-    write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
+    if "cyclic" in a.only:
+        lines = ["| CSR | seed | e0 | N to liquefaction | ru max | DA strain max [%] | cycles run | volume drift max | wall [s] |",
+                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        fig = plt.figure(figsize=(5.5, 4.2))
+        for name, (g, preset, s, d) in sorted(done.items()):
+            if g != "cyclic":
+                continue
+            n = s["n_cycles_to_liquefaction"]
+            lines.append(f"| {s['csr']:g} | {s['seed']} | {s['e0']:.3f} | {fmt(n)} | {fmt(s['ru_max'])} | "
+                         f"{100 * s['double_amplitude_strain_max']:.2f} | {s['cycles']:g} | {s['volume_drift_max']:.1e} | "
+                         f"{s['wall_seconds']:.0f} |")
+            if n is not None:
+                plt.semilogx([n], [s["csr"]], "o", color="tab:red")
+            else:
+                plt.semilogx([s["cycles"]], [s["csr"]], ">", color="tab:grey")
+        plt.xlabel("cycles to liquefaction N (grey ▶: not liquefied in the cycles run)")
+        plt.ylabel("CSR = q_cyc / (2 p0)")
+        plt.grid(alpha=0.3, which="both")
+        plt.title("Undrained cyclic triaxial, loose, p0 = 200 kPa", fontsize=10)
+        plt.tight_layout()
+        plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
+        plt.close()
+        write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
     # Cyclic simple shear.
-    per_amp = {}
-    lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | wall [s] |",
-             "|---:|---:|---:|---:|---|---|---:|"]
-    fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != "css":
-            continue
-        amps, ratio, xi = s["shear_strain_amplitudes"], s["G_over_Gmax"], s["damping_ratio"]
-        for k, (am, r, x) in enumerate(zip(amps, ratio, xi)):
-            per_amp.setdefault(k, []).append((am, r, x))
-        gp = s["E0_MPa"] / (2 * (1 + s["nu0"])) if s.get("E0_MPa") and s.get("nu0") is not None else None
-        lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
-                     + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
-                     + ", ".join(f"{100 * x:.2f}" for x in xi) + f" | {s['wall_seconds']:.0f} |")
-        axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
-        axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
-    axg.set_xlabel("shear strain amplitude γa")
-    axg.set_ylabel("G / Gmax")
-    axd.set_xlabel("shear strain amplitude γa")
-    axd.set_ylabel("damping ratio ξ [%]")
-    for x in (axg, axd):
-        x.grid(alpha=0.3, which="both")
-        x.legend(fontsize=8)
-    fig.suptitle("Drained cyclic simple shear, dense, σzz = 200 kPa", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "css.png"), dpi=110)
-    plt.close(fig)
-    lines.append("")
-    lines.append("| γa | G/Gmax | ξ [%] |")
-    lines.append("|---:|---|---|")
-    for k in sorted(per_amp):
-        v = per_amp[k]
-        lines.append(f"| {statistics.mean(x[0] for x in v):.1e} | {mean_sd([x[1] for x in v])} | "
-                     f"{mean_sd([100 * x[2] for x in v])} |")
-    write_table(os.path.join(out_dir, "css-table.md"), lines)
+    if "css" in a.only:
+        per_amp = {}
+        lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | wall [s] |",
+                 "|---:|---:|---:|---:|---|---|---:|"]
+        fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
+        for name, (g, preset, s, d) in sorted(done.items()):
+            if g != "css":
+                continue
+            amps, ratio, xi = s["shear_strain_amplitudes"], s["G_over_Gmax"], s["damping_ratio"]
+            for k, (am, r, x) in enumerate(zip(amps, ratio, xi)):
+                per_amp.setdefault(k, []).append((am, r, x))
+            gp = s["E0_MPa"] / (2 * (1 + s["nu0"])) if s.get("E0_MPa") and s.get("nu0") is not None else None
+            lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
+                         + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
+                         + ", ".join(f"{100 * x:.2f}" for x in xi) + f" | {s['wall_seconds']:.0f} |")
+            axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
+            axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
+        axg.set_xlabel("shear strain amplitude γa")
+        axg.set_ylabel("G / Gmax")
+        axd.set_xlabel("shear strain amplitude γa")
+        axd.set_ylabel("damping ratio ξ [%]")
+        for x in (axg, axd):
+            x.grid(alpha=0.3, which="both")
+            x.legend(fontsize=8)
+        fig.suptitle("Drained cyclic simple shear, dense, σzz = 200 kPa", fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "css.png"), dpi=110)
+        plt.close(fig)
+        lines.append("")
+        lines.append("| γa | G/Gmax | ξ [%] |")
+        lines.append("|---:|---|---|")
+        for k in sorted(per_amp):
+            v = per_amp[k]
+            lines.append(f"| {statistics.mean(x[0] for x in v):.1e} | {mean_sd([x[1] for x in v])} | "
+                         f"{mean_sd([100 * x[2] for x in v])} |")
+        write_table(os.path.join(out_dir, "css-table.md"), lines)
     # A group none of whose cases completed has no table or plot (not an empty one).
     files = {"cu": ("undrained-table.md", "undrained.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
              "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png")}
+    # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
     for g, names in files.items():
-        if g not in ran:
+        if g in a.only and g not in ran:
             for n in names:
                 if os.path.exists(os.path.join(out_dir, n)):
                     os.remove(os.path.join(out_dir, n))
