@@ -528,6 +528,13 @@ PYBIND11_MODULE(_grainlab, m) {
       .def_property_readonly("void_ratio", [](const PySimulation& s) { return lab::voidRatio(s.sim()); })
       .def_property_readonly("coordination", [](const PySimulation& s) { return lab::coordinationNumber(s.sim()); })
       .def_property_readonly("unbalanced", [](const PySimulation& s) { return lab::unbalancedForceRatio(s.sim()); })
+      .def_property_readonly("wall_positions", [](const PySimulation& s) -> py::object {
+            // xlo, xhi, ylo, yhi, zlo, zhi [m]: the planes of the six walls (None for a cell).
+            if (s.sim().boundary == Boundary::Periodic) return py::none();
+            std::array<double, 6> planes{};
+            for (const Wall& w : s.sim().box.walls) planes[2 * w.axis + w.side] = w.position;
+            return py::cast(planes);
+          })
       .def_property_readonly("lengths", [](const PySimulation& s) { return vector3(lab::sampleLengths(s.sim())); })
       .def_property_readonly("volume", [](const PySimulation& s) { return s.sim().volume(); })
       .def_property_readonly("strain", [](const PySimulation& s) { return vector3(s.strain()); })

@@ -891,7 +891,7 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       for (const auto& [mu, e] : prep.search) search.push_back({{"prep_friction_deg", mu}, {"e", e}});
       s["prep_search"] = search;
       s["grading"] = gradingJson(prep.grading);
-      if (config.contact.model == "rolling-linear") {
+      if (config.contact.rollingSlot() == "rolling-linear") {
         const auto& mu = sim.particles.rollingFriction;
         double sum = 0.0;
         for (double m : mu) sum += m;

@@ -35,6 +35,7 @@ struct ContactContext {
 enum ContactSum : int {
   kSlip = 0,
   kRoll,
+  kViscous,  // Hertz–Mindlin's normal dashpots
   // Periodic cell only: Love–Weber stress terms f_i l_j (9) and the servo's affine stiffnesses
   // (3 normal: xx, yy, zz; 3 shear: yz, xz, xy).
   kStress0,
@@ -126,7 +127,12 @@ struct PairKernelBase {
     const auto& r = EquivalentRadius ? ctx.particles.equivalentRadius : ctx.particles.radius;
     const auto& mu = ctx.particles.rollingFriction;
     const std::uint32_t a = list.a[c], b = list.b[c];
-    return ctx.model.pairParams(r[a], r[b], mu[a], mu[b]);
+    contact::PairParams p = ctx.model.pairParams(r[a], r[b], mu[a], mu[b]);
+    if (ctx.model.restitutionBeta != 0.0) {
+      const auto& m = ctx.particles.mass;
+      p.damping = ctx.model.dampingFactor(m[a] * m[b] / (m[a] + m[b]));
+    }
+    return p;
   }
   GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
                                            const contact::ContactResponse& res) {
@@ -146,7 +152,9 @@ struct WallKernelBase {
   GRAINLAB_ALWAYS_INLINE static contact::PairParams params(const ContactContext& ctx, const List& list, std::size_t c) {
     const std::uint32_t i = list.a[c];
     const double r = EquivalentRadius ? ctx.particles.equivalentRadius[i] : ctx.particles.radius[i];
-    return ctx.model.wallParams(r, ctx.box.walls[list.b[c]].tanFriction, ctx.particles.rollingFriction[i]);
+    contact::PairParams p = ctx.model.wallParams(r, ctx.box.walls[list.b[c]].tanFriction, ctx.particles.rollingFriction[i]);
+    if (ctx.model.restitutionBeta != 0.0) p.damping = ctx.model.dampingFactor(ctx.particles.mass[i]);
+    return p;
   }
   GRAINLAB_ALWAYS_INLINE static void store(List& list, std::size_t c, const geometry::ContactGeometry& g,
                                            const contact::ContactResponse& res) {
@@ -256,14 +264,14 @@ struct KindKernel<EllipsoidPlane, Periodic> : WallKernelBase<EllipsoidPlane, tru
 
 // Evaluates every contact of `list`; call from every thread of an OpenMP parallel region (the loop
 // is a work-shared `omp for` without a barrier at its end). `sums` holds kContactSums terms per chunk
-// when Periodic, else kSlip and kRoll.
+// when Periodic, else kSlip, kRoll and kViscous.
 template <class Kind, bool Periodic>
 void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, ChunkedSums& sums, bool writeAll) {
   using Kernel = detail::KindKernel<Kind, Periodic>;
   // Chunks are scheduled dynamically: only touching pairs run the contact law.
 #pragma omp for schedule(dynamic, 1) nowait
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
-    double slip = 0.0, roll = 0.0;
+    double slip = 0.0, roll = 0.0, viscous = 0.0;
     Mat3 stress = Mat3::Zero();
     Vec3 stiffness = Vec3::Zero(), shearStiffness = Vec3::Zero();
     for (std::size_t c = sums.begin(chunk); c < sums.end(chunk); ++c) {
@@ -277,7 +285,8 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
           // The contact opens: what its shear and moment springs still hold is released with the
           // history (the model keeps no memory of it), so it is booked as dissipated, slip and
           // rolling, and the energy balance stays closed.
-          const contact::PairParams p = Kernel::params(ctx, list, c);
+          contact::PairParams p = Kernel::params(ctx, list, c);
+          contact::SphereContactModel::resolve(p, h.overlap);  // Hertz–Mindlin: the springs' last stiffness
           if (p.ks > 0.0) slip += 0.5 * h.shearForce.squaredNorm() / p.ks;
           if (p.kr > 0.0) roll += 0.5 * h.moment.squaredNorm() / p.kr;
         }
@@ -291,9 +300,16 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
         h.touching = true;
         h.prevNormal = g.normal;
       }
-      const contact::PairParams p = Kernel::params(ctx, list, c);
+      contact::PairParams p = Kernel::params(ctx, list, c);
       contact::ContactResponse res;
-      if (p.tanFriction <= 0.0 && p.kr <= 0.0) {
+      if (p.hertz > 0.0) {
+        contact::SphereContactModel::resolve(p, g.overlap);
+        contact::ContactKinematics k = Kernel::kinematics(ctx, list, c, g, branch);
+        k.prevNormal = h.prevNormal;
+        double dashpot;
+        res = contact::applyHertzMindlin(p, k, h, dashpot);
+        viscous += dashpot;
+      } else if (p.tanFriction <= 0.0 && p.kr <= 0.0) {
         // Frictionless and without a moment spring (a smooth wall, a growth stage at mu = 0): the
         // normal spring alone, without the kinematics the tangential and moment slots need.
         res = contact::applyNormalLaw(p, g.normal, g.overlap, h);
@@ -320,6 +336,7 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
     }
     sums.at(chunk, kSlip) = slip;
     sums.at(chunk, kRoll) = roll;
+    sums.at(chunk, kViscous) = viscous;
     if constexpr (Periodic) {
       for (int i = 0; i < 9; ++i) sums.at(chunk, kStress0 + i) = stress(i % 3, i / 3);
       for (int i = 0; i < 3; ++i) sums.at(chunk, kStiffness0 + i) = stiffness[i];

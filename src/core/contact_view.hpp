@@ -19,11 +19,11 @@ struct ContactView {
   Vec3 branch = Vec3::Zero();
   // Contact point minus the centre of a and of b (for a wall only armA is meaningful).
   Vec3 armA = Vec3::Zero(), armB = Vec3::Zero();
-  double overlap = 0.0;  // [m] force-equivalent: Fn = kn overlap
-  // Energy stored in the normal spring [J]: kn overlap^2 / 2, or for an ellipsoid pair the
-  // potential of its contact function (docs/ellipsoids.md).
+  double overlap = 0.0;  // [m] force-equivalent: Fn = kn overlap (Hertz–Mindlin: Fn = hertz overlap^(3/2))
+  // Energy stored in the normal spring [J]: kn overlap^2 / 2 (Hertz: 2/5 Fn overlap), or for an
+  // ellipsoid pair the potential of its contact function (docs/ellipsoids.md).
   double normalEnergy = 0.0;
-  contact::PairParams params{};
+  contact::PairParams params{};  // Hertz–Mindlin: resolved at the overlap (tangent stiffnesses)
   const contact::ContactHistory* history = nullptr;
 };
 
@@ -50,7 +50,8 @@ void forEachTouchingContact(const Simulation& sim, F&& f) {
     v.armA = (r[v.a] - 0.5 * v.overlap) * v.normal;
     v.armB = v.armA - v.branch;
     v.params = sim.model.pairParams(r[v.a], r[v.b], mu[v.a], mu[v.b]);
-    v.normalEnergy = 0.5 * v.params.kn * v.overlap * v.overlap;
+    contact::SphereContactModel::resolve(v.params, v.overlap);
+    v.normalEnergy = contact::SphereContactModel::normalEnergy(v.params, v.overlap);
     v.history = &pairs.history[c];
     f(static_cast<const ContactView&>(v));
   }
@@ -69,7 +70,8 @@ void forEachTouchingContact(const Simulation& sim, F&& f) {
     v.branch = -(r[v.a] - 0.5 * v.overlap) * v.normal;
     v.armA = v.branch;
     v.params = sim.model.wallParams(r[v.a], wall.tanFriction, mu[v.a]);
-    v.normalEnergy = 0.5 * v.params.kn * v.overlap * v.overlap;
+    contact::SphereContactModel::resolve(v.params, v.overlap);
+    v.normalEnergy = contact::SphereContactModel::normalEnergy(v.params, v.overlap);
     v.history = &walls.history[c];
     f(static_cast<const ContactView&>(v));
   }

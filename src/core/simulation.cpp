@@ -152,12 +152,12 @@ void Simulation::computeContactsFor() {
         if (particles.shape[i] == Shape::Ellipsoid)
           shapeMatrices_[i] = geometry::shapeMatrix(particles.semiAxes[i], particles.orientation[i]);
     }
-    const int pairTerms = Periodic ? kContactSums : 2;
+    const int pairTerms = Periodic ? kContactSums : 3;
     pairSums_.reset(pairs.size(), pairTerms);
-    wallSums_.reset(walls.size(), 2);
+    wallSums_.reset(walls.size(), 3);
     eeSums_.reset(ee.size(), pairTerms);
     seSums_.reset(se.size(), pairTerms);
-    ewSums_.reset(ew.size(), 2);
+    ewSums_.reset(ew.size(), 3);
     integrateSums_.reset(particles.size(), kIntegrateSums);  // the integrate stage's, cut here to save a barrier
     // Every slot is written once after the list changed; then apart pairs are skipped.
     int k = 0;
@@ -192,6 +192,7 @@ void Simulation::sumContactTerms(bool ellipsoids) {
                     &ewSums = ewSums_;
   energy.slip += pairSums.total(kSlip) + wallSums.total(kSlip);
   energy.rolling += pairSums.total(kRoll) + wallSums.total(kRoll);
+  if (model.restitutionBeta != 0.0) energy.damping += pairSums.total(kViscous) + wallSums.total(kViscous);
   if (ellipsoids) {
     energy.slip += eeSums.total(kSlip) + seSums.total(kSlip) + ewSums.total(kSlip);
     energy.rolling += eeSums.total(kRoll) + seSums.total(kRoll) + ewSums.total(kRoll);
@@ -264,7 +265,14 @@ void Simulation::sumWallForces(int group, int groups) {
       if (static_cast<int>(k % groups) != group || !list.history[c].touching) continue;
       const Wall& wall = box.walls[k];
       force[k] += list.force[c].dot(wall.inwardNormal());
-      stiffness[k] += model.wallParams(radius[list.a[c]], wall.tanFriction).kn;
+      contact::PairParams p = model.wallParams(radius[list.a[c]], wall.tanFriction);
+      contact::SphereContactModel::resolve(p, list.history[c].overlap);  // Hertz–Mindlin: tangent Kn
+      stiffness[k] += p.kn;
+      // A normal dashpot answers the wall's own speed: moved by u in one step, the wall meets
+      // Kn u + c u / dt. Counted in, the servo's step stays stable with stiff dashpots (without it
+      // the wall rings between its speed limits).
+      if (model.restitutionBeta != 0.0)
+        stiffness[k] += model.dampingFactor(particles.mass[list.a[c]]) * std::sqrt(p.kn) / dt;
       ++touching[k];
     }
   };

@@ -31,7 +31,7 @@ namespace grainlab {
 struct EnergyLedger {
   double slip = 0.0;
   double rolling = 0.0;
-  double damping = 0.0;
+  double damping = 0.0;       // local or viscous damping of the particles, and Hertz–Mindlin's dashpots
   double boundaryWork = 0.0;  // work done on the particles by the walls or the deforming cell
 };
 

@@ -133,18 +133,20 @@ inline void get(std::istream& in, Mat3& m) {
   for (int k = 0; k < 9; ++k) get(in, m(k % 3, k / 3));
 }
 
-static_assert(fieldCount<contact::ContactHistory>() == 4,
+static_assert(fieldCount<contact::ContactHistory>() == 5,
               "a field was added to ContactHistory: write and read it below");
 inline void put(std::ostream& out, const contact::ContactHistory& h) {
   put(out, h.shearForce);
   put(out, h.moment);
   put(out, h.prevNormal);
+  put(out, h.overlap);
   put(out, h.touching);
 }
 inline void get(std::istream& in, contact::ContactHistory& h) {
   get(in, h.shearForce);
   get(in, h.moment);
   get(in, h.prevNormal);
+  get(in, h.overlap);
   get(in, h.touching);
 }
 
@@ -167,8 +169,8 @@ constexpr std::size_t encodedSize() {
   else if constexpr (std::is_same_v<T, Vec3>) return 3 * sizeof(double);
   else if constexpr (std::is_same_v<T, Quat>) return 4 * sizeof(double);
   else if constexpr (std::is_same_v<T, Mat3>) return 9 * sizeof(double);
-  else if constexpr (std::is_same_v<T, contact::ContactHistory>) return 9 * sizeof(double) + 1;
-  else if constexpr (std::is_same_v<T, contact::EllipsoidHistory>) return 11 * sizeof(double) + 1;
+  else if constexpr (std::is_same_v<T, contact::ContactHistory>) return 10 * sizeof(double) + 1;
+  else if constexpr (std::is_same_v<T, contact::EllipsoidHistory>) return 12 * sizeof(double) + 1;
   else return sizeof(T);
 }
 

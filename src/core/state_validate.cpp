@@ -94,8 +94,13 @@ void Simulation::validateState() const {
       !finiteIn(model.tanFriction, 0.0, 1e300) || !finiteIn(model.beta, 0.0, 1e300) || !finiteIn(model.eta, 0.0, 1e300) ||
       !finiteIn(model.constantKn, 0.0, 1e300))
     bad("contact model parameters not finite or out of range");
-  if (model.rolling != contact::RollingLaw::KozickiDonze && model.rolling != contact::RollingLaw::Linear)
+  if (model.rolling != contact::RollingLaw::KozickiDonze && model.rolling != contact::RollingLaw::Linear &&
+      model.rolling != contact::RollingLaw::None)
     bad("unknown rolling law");
+  if (model.law != contact::NormalLaw::Linear && model.law != contact::NormalLaw::HertzMindlin) bad("unknown contact law");
+  if (model.hertz() && (!(model.poisson < 0.5) || model.constantKn != 0.0)) bad("Hertz–Mindlin parameters out of range");
+  if (!finiteIn(model.restitutionBeta, -1.0, 0.0)) bad("restitution damping ratio out of range");
+  if (!finiteIn(model.referenceStress, 0.0, 1e12)) bad("Hertz reference stress out of range");
   if (model.combine != contact::CombineRule::Min && model.combine != contact::CombineRule::Mean &&
       model.combine != contact::CombineRule::Harmonic)
     bad("unknown rolling-friction combination rule");
@@ -164,6 +169,8 @@ void Simulation::validateState() const {
       const auto& h = list.history[c];
       if (!finite(h.shearForce) || !finite(h.moment) || !finite(h.prevNormal) || !finite(list.force[c]))
         bad(fmt::format("{} contact {}: non-finite history", Kind::kName, c));
+      if (!(h.overlap >= 0.0) || !std::isfinite(h.overlap))
+        bad(fmt::format("{} contact {}: overlap negative or not finite", Kind::kName, c));
     }
   });
 }

@@ -23,6 +23,13 @@ double Simulation::criticalTimeStep() const {
       continue;
     }
     const double r = particles.radius[i];
+    if (model.hertz()) {
+      // Hertz–Mindlin: also the Rayleigh time pi r sqrt(rho/G) / (0.1631 nu + 0.8766) of the grain
+      // (the time a Rayleigh wave takes to cross it), besides the stiffnesses at the reference overlap.
+      const double nu = model.poisson, shear = model.young / (2.0 * (1.0 + nu));
+      const double rho = particles.mass[i] / (4.0 / 3.0 * kPi * r * r * r);
+      dtc = std::min(dtc, kPi * r * std::sqrt(rho / shear) / (0.1631 * nu + 0.8766));
+    }
     dtc = std::min(dtc, std::sqrt(particles.mass[i] / model.maxNormalStiffness(r)));
     dtc = std::min(dtc, std::sqrt(particles.inertia[i] / model.maxRotationalStiffness(r)));
   }

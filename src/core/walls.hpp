@@ -22,7 +22,7 @@ struct Wall {
   double servoIntegral = 0.0;  // integral term of the stress servo, as an inward speed [m/s]
   // Measured every step by the contact stage:
   double normalForce = 0.0;    // total force pushed onto the wall by particles, >0 in compression [N]
-  double contactStiffness = 0.0;  // sum of Kn of its contacts [N/m]
+  double contactStiffness = 0.0;  // sum of Kn of its contacts (and of their dashpots' c/dt) [N/m]
   int contacts = 0;
 
   // Signed distance of a point from the plane, positive on the inside of the box [m].

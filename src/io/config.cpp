@@ -198,7 +198,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
         "lattice_jitter", "shape", "packing_friction_deg"}},
       {"contact",
        {"model", "young", "poisson", "friction_deg", "beta", "eta", "wall_friction_deg", "moment_limit", "kn",
-        "rolling_friction", "sphericity"}},
+        "rolling_friction", "sphericity", "shear_modulus", "rolling", "restitution"}},
       {"test",
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
@@ -517,12 +517,20 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "not used with sample.method = \"lattice\" (no loose placement)";
   if (key.rfind("sample.shape.", 0) == 0 && key != "sample.shape.type" && c.sample.shape.type != "ellipsoid")
     return "only used with sample.shape.type = \"ellipsoid\"; " + here("sample.shape.type", c.sample.shape.type);
-  const bool linear = c.contact.model == "rolling-linear";
-  if ((key == "contact.beta" || key == "contact.eta" || key == "contact.moment_limit") && linear)
-    return "only used with contact.model = \"kozicki\" (rolling-linear has rolling_friction or sphericity); " +
-           here("contact.model", c.contact.model);
-  if ((key == "contact.rolling_friction" || key == "contact.sphericity") && !linear)
-    return "only used with contact.model = \"rolling-linear\"; " + here("contact.model", c.contact.model);
+  const bool hertz = c.contact.hertz();
+  const std::string& slot = c.contact.rollingSlot();
+  const std::string slotHere = hertz ? here("contact.rolling", c.contact.rolling) : here("contact.model", c.contact.model);
+  if ((key == "contact.beta" || key == "contact.eta" || key == "contact.moment_limit") && slot != "kozicki")
+    return "only used with the Kozicki–Donze moments (contact.model = \"kozicki\", or \"hertz-mindlin\" with "
+           "contact.rolling = \"kozicki\"); " + slotHere;
+  if ((key == "contact.rolling_friction" || key == "contact.sphericity") && slot != "rolling-linear")
+    return "only used with the linear rolling resistance (contact.model = \"rolling-linear\", or \"hertz-mindlin\" "
+           "with contact.rolling = \"rolling-linear\"); " + slotHere;
+  if ((key == "contact.shear_modulus" || key == "contact.rolling" || key == "contact.restitution") && !hertz)
+    return "only used with contact.model = \"hertz-mindlin\"; " + here("contact.model", c.contact.model);
+  if ((key == "contact.young" || key == "contact.kn") && hertz)
+    return "not used with contact.model = \"hertz-mindlin\" (its stiffness follows from contact.shear_modulus and "
+           "contact.poisson)";
   if (key == "contact.rolling_friction" && c.contact.sphericity)
     return "give either contact.rolling_friction or contact.sphericity, not both";
   if (key == "contact.wall_friction_deg" && c.test.boundary == "periodic")
@@ -603,8 +611,14 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
           "test.ru_limit", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
           "test.cycles_per_amplitude"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
+      // And a config of one contact law run with another (--set contact.model="hertz-mindlin" on a
+      // preset): the other law's parameters warn.
+      static const std::set<std::string> contactLawKeys{"contact.young", "contact.kn", "contact.beta", "contact.eta",
+                                                        "contact.moment_limit", "contact.shear_modulus",
+                                                        "contact.rolling", "contact.restitution"};
+      const bool otherLawKey = contactLawKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
-          otherTestsKey) {
+          otherTestsKey || otherLawKey) {
         c.warnings.push_back(fmt::format("{} = {} is ignored: {}", key, printable(show(*node)), why));
         continue;
       }
@@ -841,9 +855,24 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   s.finish();
 
   Section ct(root, "contact");
-  c.contact.model = ct.string("model", c.contact.model, {"kozicki", "rolling-linear"});
+  c.contact.model = ct.string("model", c.contact.model, {"kozicki", "rolling-linear", "hertz-mindlin"});
+  const bool hertz = c.contact.hertz();
   c.contact.young = ct.number("young", c.contact.young, 1e3, 1e15, false, false, "must be in [1e3, 1e15] [Pa]");
-  c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 1.0, false, false, "must be in [0, 1] (Ks = poisson * Kn)");
+  if (hertz) {
+    c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 0.5, false, true,
+                                  "must be in [0, 0.5) (Poisson's ratio of the grain material, contact.model = \"hertz-mindlin\")");
+    if (c.sample.shape.type == "ellipsoid")
+      fail("contact.model", "\"hertz-mindlin\"",
+           "not available with sample.shape.type = \"ellipsoid\" (Hertz's law of two ellipsoids needs their local "
+           "curvatures, which grainlab does not compute); allowed there: \"kozicki\", \"rolling-linear\"");
+  } else {
+    c.contact.poisson = ct.number("poisson", c.contact.poisson, 0.0, 1.0, false, false, "must be in [0, 1] (Ks = poisson * Kn)");
+  }
+  c.contact.shearModulus = ct.number("shear_modulus", c.contact.shearModulus, 1e3, 1e13, false, false,
+                                     "must be in [1e3, 1e13] [Pa] (the grain material's shear modulus G)");
+  c.contact.rolling = ct.string("rolling", c.contact.rolling, {"none", "kozicki", "rolling-linear"});
+  c.contact.restitution = ct.number("restitution", c.contact.restitution, 0.0, 1.0, true, false,
+                                    "must be in (0, 1] (normal coefficient of restitution; 1: no dashpot)");
   c.contact.frictionDeg = ct.number("friction_deg", c.contact.frictionDeg, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   c.contact.beta = ct.number("beta", c.contact.beta, 0.0, 1e6, false, false, "must be >= 0");
   c.contact.eta = ct.number("eta", c.contact.eta, 0.0, 1e6, false, false, "must be >= 0");
@@ -851,12 +880,13 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.contact.momentLimit = ct.string("moment_limit", c.contact.momentLimit, {"mean-radius", "yade"});
   if (ct.raw("kn"))
     c.contact.kn = ct.number("kn", 0.0, 1e-3, 1e15, false, false, "must be in [1e-3, 1e15] [N/m] (a constant normal stiffness)");
-  const bool linear = c.contact.model == "rolling-linear";
+  const bool linear = c.contact.rollingSlot() == "rolling-linear";
   const toml::node* mu = ct.raw("rolling_friction");
   const toml::node* sph = ct.raw("sphericity");
   if (!linear && (mu || sph))
     fail(ct.path(mu ? "rolling_friction" : "sphericity"), show(mu ? *mu : *sph),
-         "only used with contact.model = \"rolling-linear\"");
+         "only used with the linear rolling resistance (contact.model = \"rolling-linear\", or \"hertz-mindlin\" "
+         "with contact.rolling = \"rolling-linear\")");
   if (mu && sph) fail("contact.sphericity", show(*sph), "give either contact.rolling_friction or contact.sphericity, not both");
   c.contact.rollingFriction = ct.number("rolling_friction", c.contact.rollingFriction, 0.0, 10.0, false, false, "must be in [0, 10] (mu_r)");
   if (sph) {
@@ -1096,6 +1126,9 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                       {"poisson", c.contact.poisson},
                       {"friction_deg", c.contact.frictionDeg}};
   put(contact, "contact", "young", c.contact.young);
+  put(contact, "contact", "shear_modulus", c.contact.shearModulus);
+  put(contact, "contact", "rolling", c.contact.rolling);
+  put(contact, "contact", "restitution", c.contact.restitution);
   put(contact, "contact", "beta", c.contact.beta);
   put(contact, "contact", "eta", c.contact.eta);
   put(contact, "contact", "wall_friction_deg", c.contact.wallFrictionDeg);

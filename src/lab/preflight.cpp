@@ -20,7 +20,9 @@ bool usable(double v, bool zeroAllowed) { return std::isfinite(v) && (std::abs(v
 void checkDerived(const RunConfig& c, const Simulation& sim) {
   const Particles& P = sim.particles;
   const std::string source = c.sample.packing.empty() ? "sample.grading, sample.density" : "sample.packing, sample.density";
-  const std::string stiffness = c.contact.kn ? "contact.kn" : "contact.young";
+  const std::string stiffness = c.contact.kn                       ? "contact.kn"
+                                : c.contact.model == "hertz-mindlin" ? "contact.shear_modulus"
+                                                                    : "contact.young";
   for (std::size_t i = 0; i < P.size(); ++i) {
     const double r = P.radius[i];
     auto refuse = [&](const char* what, double v, const std::string& keys) {
@@ -33,8 +35,8 @@ void checkDerived(const RunConfig& c, const Simulation& sim) {
     if (!usable(P.inertia[i], false)) refuse("moment of inertia", P.inertia[i], source);
     const double kn = sim.model.maxNormalStiffness(r);
     if (!usable(kn, false)) refuse("normal stiffness Kn", kn, stiffness + ", " + source);
-    const double ks = sim.model.poisson * kn;
-    if (!usable(ks, true)) refuse("shear stiffness Ks = poisson x Kn", ks, stiffness + ", contact.poisson");
+    const double ks = sim.model.maxShearStiffness(r);
+    if (!usable(ks, true)) refuse("shear stiffness Ks", ks, stiffness + ", contact.poisson");
     const double kr = sim.model.maxRotationalStiffness(r) - ks * r * r;
     if (!usable(kr, true))
       refuse("rolling stiffness Kr = beta x Ks x R^2", kr, stiffness + ", contact.beta, contact.poisson");

@@ -20,7 +20,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   // Rearrangement during compaction is paced by the grains' inertial time d sqrt(rho/p), not by
   // the contact stiffness; softer contacts allow a proportionally longer time step, so compaction
   // runs at Ec * prep_stiffness_factor. The packing is then stiffened to Ec and re-equilibrated.
-  sim_.model.young = config_.contact.young * config_.sample.prepStiffnessFactor;
+  sim_.model.young = config_.contact.modelYoung() * config_.sample.prepStiffnessFactor;
   sim_.dt = config_.solver.dtFactor * sim_.criticalTimeStep();
   sim_.localDamping = config_.sample.prepDamping;
   setFriction(muDeg);

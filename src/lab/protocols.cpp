@@ -13,12 +13,17 @@
 namespace grainlab::lab {
 
 void configureSolver(const RunConfig& c, Simulation& sim) {
-  sim.model.young = c.contact.young;
+  sim.model.young = c.contact.modelYoung();
   sim.model.poisson = c.contact.poisson;
   sim.model.beta = c.contact.beta;
   sim.model.eta = c.contact.eta;
-  sim.model.rolling = c.contact.model == "rolling-linear" ? contact::RollingLaw::Linear
-                                                          : contact::RollingLaw::KozickiDonze;
+  const std::string& slot = c.contact.rollingSlot();
+  sim.model.rolling = slot == "rolling-linear" ? contact::RollingLaw::Linear
+                      : slot == "none"         ? contact::RollingLaw::None
+                                               : contact::RollingLaw::KozickiDonze;
+  sim.model.law = c.contact.hertz() ? contact::NormalLaw::HertzMindlin : contact::NormalLaw::Linear;
+  sim.model.restitutionBeta = c.contact.hertz() ? contact::restitutionDampingRatio(c.contact.restitution) : 0.0;
+  sim.model.referenceStress = c.contact.hertz() ? c.test.largestStress() : 0.0;
   if (c.contact.sphericity) {
     const std::string& rule = c.contact.sphericity->combine;
     sim.model.combine = rule == "mean"       ? contact::CombineRule::Mean
@@ -130,8 +135,10 @@ long Laboratory::rampStiffness() {
   Pipeline pipeline(sim_);
   long i = 0;
   pipeline.addBefore("stiffness ramp", [&] {
-    sim_.model.young = std::min(config_.contact.young, sim_.model.young * growth);
-    sim_.dt = dtFromYoung / std::sqrt(sim_.model.young);
+    sim_.model.young = std::min(config_.contact.modelYoung(), sim_.model.young * growth);
+    // Hertz–Mindlin's stiffness at a given load goes as E^(2/3), not E: the estimate again.
+    sim_.dt = sim_.model.hertz() ? config_.solver.dtFactor * sim_.criticalTimeStep()
+                                 : dtFromYoung / std::sqrt(sim_.model.young);
   });
   pipeline.addAfter("ramp progress", [&] {
     if (progress_ && i % 1000 == 0) progress_("stiffness ramp", static_cast<double>(i) / rampSteps, i);
@@ -201,7 +208,7 @@ long Laboratory::growRadii() {
 
 std::vector<double> assignRollingFriction(const RunConfig& c, Particles& particles) {
   const std::size_t n = particles.size();
-  if (c.contact.model != "rolling-linear") return std::vector<double>(n, 1.0);
+  if (c.contact.rollingSlot() != "rolling-linear") return std::vector<double>(n, 1.0);
   if (!c.contact.sphericity) {
     particles.rollingFriction.assign(n, c.contact.rollingFriction);
     return std::vector<double>(n, 1.0);

@@ -1,6 +1,8 @@
 #pragma once
 // The full description of a laboratory run. Every field has a default; io/config.cpp fills it from
 // TOML and validates it, and writes it back out with every default resolved. Units SI, angles deg.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -95,9 +97,21 @@ struct SphericityConfig {
 };
 
 struct ContactConfig {
-  std::string model = "kozicki";  // "kozicki" [W] | "rolling-linear" [R]
-  double young = 30.0e9;        // Ec [Pa]
-  double poisson = 0.3;         // nu_c [-]
+  // "kozicki" [W] | "rolling-linear" [R] (linear springs) | "hertz-mindlin" (docs/physics.md §4.6)
+  std::string model = "kozicki";
+  double young = 30.0e9;        // Ec [Pa] (linear laws)
+  double poisson = 0.3;         // nu_c = Ks/Kn [-]; hertz-mindlin: Poisson's ratio of the grain material
+  // hertz-mindlin only: the grain material's shear modulus G [Pa] (quartz about 29 GPa), the rolling
+  // slot ("none", "kozicki" or "rolling-linear") and the normal coefficient of restitution (1: no
+  // dashpot).
+  double shearModulus = 29.0e9;
+  std::string rolling = "none";
+  double restitution = 1.0;
+  bool hertz() const { return model == "hertz-mindlin"; }
+  // The rolling slot in use: the linear models name theirs, Hertz–Mindlin takes contact.rolling.
+  const std::string& rollingSlot() const { return hertz() ? rolling : model; }
+  // The Young's modulus the engine's model carries: Ec, or E = 2 G (1 + nu) of the grain material.
+  double modelYoung() const { return hertz() ? 2.0 * shearModulus * (1.0 + poisson) : young; }
   double frictionDeg = 30.0;    // mu [deg]
   double beta = 0.15;           // rolling stiffness coefficient [-]
   double eta = 1.0;             // moment limit coefficient [-]
@@ -167,6 +181,18 @@ struct TestConfig {
   // each cycled this many times.
   std::vector<double> shearStrainAmplitudes{1e-5, 1e-4, 1e-3};
   long cyclesPerAmplitude = 2;
+
+  // The largest boundary stress the test asks for before the sample's own deviator (the confining
+  // pressure, the oedometer's turning stress, a stress path's targets) [Pa]; Hertz–Mindlin's
+  // reference overlap for the time step follows it (contact::hertzReferenceOverlap).
+  double largestStress() const {
+    double s = confiningPressure;
+    if (type == TestType::Oedometer) s = std::max(s, maxAxialStress);
+    for (const PathPoint& p : path)
+      for (int a = 0; a < 3; ++a)
+        if (p.control[a] == PathControl::Stress) s = std::max(s, std::abs(p.value[a]));
+    return s;
+  }
 };
 
 struct SolverConfig {

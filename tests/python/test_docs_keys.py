@@ -120,6 +120,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "cyclic-triaxial": '[test]\ntype = "cyclic-triaxial"\n',
         "cyclic-simple-shear": '[test]\ntype = "cyclic-simple-shear"\nboundary = "periodic"\n',
         "dt": '[solver]\ndt = 1e-7\n',
+        "hertz-mindlin": '[contact]\nmodel = "hertz-mindlin"\n',
     }
     printed = {}
     for name, text in configs.items():

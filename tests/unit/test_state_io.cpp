@@ -58,7 +58,7 @@ struct ShearStateMembers {
 static_assert(stateio::fieldCount<Particles>() == 19,
               "Particles changed: update Particles::saveState/loadState and this count (16 saved + invMass, "
               "invInertia, equivalentRadius derived)");
-static_assert(stateio::fieldCount<contact::ContactHistory>() == 4, "ContactHistory changed: update state_io.hpp");
+static_assert(stateio::fieldCount<contact::ContactHistory>() == 5, "ContactHistory changed: update state_io.hpp");
 static_assert(sizeof(BroadPhase) ==
                   layoutSize<double, long, std::vector<Vec3>, std::array<double, 6>, Mat3, SpatialGrid>(),
               "BroadPhase changed: update BroadPhase::saveState/loadState and this list (the grid is scratch)");
