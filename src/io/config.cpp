@@ -611,12 +611,12 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
           "test.ru_limit", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
           "test.cycles_per_amplitude"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
-      // And a config of one contact law run with another (--set contact.model="hertz-mindlin" on a
-      // preset): the other law's parameters warn.
-      static const std::set<std::string> contactLawKeys{"contact.young", "contact.kn", "contact.beta", "contact.eta",
-                                                        "contact.moment_limit", "contact.shear_modulus",
-                                                        "contact.rolling", "contact.restitution"};
-      const bool otherLawKey = contactLawKeys.count(key) > 0;
+      // And a linear-law config run with Hertz–Mindlin (--set contact.model="hertz-mindlin" on a
+      // preset): the linear law's parameters warn. Between the linear laws, and Hertz–Mindlin's own
+      // keys under a linear law, a key that cannot apply stays an error.
+      static const std::set<std::string> linearLawKeys{"contact.young", "contact.kn", "contact.beta", "contact.eta",
+                                                       "contact.moment_limit"};
+      const bool otherLawKey = c.contact.hertz() && linearLawKeys.count(key) > 0;
       if ((!c.sample.packing.empty() && why.find("sample.packing") != std::string::npos) || preparationTarget ||
           otherTestsKey || otherLawKey) {
         c.warnings.push_back(fmt::format("{} = {} is ignored: {}", key, printable(show(*node)), why));
