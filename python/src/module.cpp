@@ -550,5 +550,6 @@ PYBIND11_MODULE(_grainlab, m) {
             d["rolling"] = s.sim().energy.rolling;
             d["damping"] = s.sim().energy.damping;
             d["boundary_work"] = s.sim().energy.boundaryWork;
+            d["gravity_work"] = s.sim().energy.gravityWork;
             return d; });
 }

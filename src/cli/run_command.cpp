@@ -30,6 +30,7 @@
 #include "io/results.hpp"
 #include "io/run_folder.hpp"
 #include "io/vtk.hpp"
+#include "lab/micro_network.hpp"
 #include "lab/grading.hpp"
 #include "lab/macro.hpp"
 #include "lab/micro_network.hpp"
@@ -909,6 +910,35 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       if (prep.coordination.Z < 2.0)
         std::fprintf(stderr, "grainlab: warning: the prepared sample stands at Z = %.2f < 2 (a house of cards)\n",
                      prep.coordination.Z);
+      // Fabric of the prepared sample: R = <n (x) n> over particle-particle contacts and its
+      // anisotropy a_r = 15/2 dev R (docs/micromechanics.md); a deposited sample prefers vertical
+      // contacts (a_r_zz > 0). Null without contacts.
+      {
+        const lab::MicroAnalysis micro = lab.microAnalyzer().analyse(lab::microNetwork(sim));
+        json fabric;
+        fabric["R_diagonal"] = {micro.fabric(0, 0), micro.fabric(1, 1), micro.fabric(2, 2)};
+        if (micro.ar) {
+          const Mat3& a = micro.ar->tensor;
+          fabric["a_r"] = std::sqrt(1.5 * a.cwiseProduct(a).sum());
+          fabric["a_r_zz"] = a(2, 2);
+          fabric["a_r_principal"] = {micro.ar->principal[0], micro.ar->principal[1], micro.ar->principal[2]};
+        } else {
+          fabric["a_r"] = nullptr;
+          fabric["a_r_zz"] = nullptr;
+          fabric["a_r_principal"] = nullptr;
+        }
+        s["fabric_after_preparation"] = fabric;
+      }
+      if (prep.deposition) {
+        const lab::DepositionReport& d = *prep.deposition;
+        s["deposition"] = {{"drop_height", d.dropHeight}, {"cloud_height", d.cloudHeight},
+                           {"cloud_solid_fraction", d.cloudSolidFraction}, {"width", d.width},
+                           {"bed_height", d.bedHeight}, {"settled_void_ratio", d.settledVoidRatio},
+                           {"settled_Z", d.settledCoordination},
+                           {"settled_a_r_zz", d.settledFabricZz ? json(*d.settledFabricZz) : json(nullptr)},
+                           {"gravity_work", d.gravityWork},
+                           {"steps", d.steps}};
+      }
       s["dt"] = sim.dt;
       s["dt_critical"] = sim.criticalTimeStep();
       s["preparation_steps"] = prep.steps;
@@ -924,6 +954,8 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       if (!opt.quiet) {
         const std::string how =
             !config.sample.packing.empty()            ? std::string("from the packing file")
+            : config.sample.method == "deposition"    ? fmt::format("deposition at {:.1f} deg: no target",
+                                                                        prep.prepFrictionDeg.value_or(0.0))
             : config.sample.method != "compaction"    ? fmt::format("frictionless {}: no target", config.sample.method)
                                                       : fmt::format("target {:.3f}, mu_prep = {:.2f} deg", config.sample.e0,
                                                                     prep.prepFrictionDeg.value_or(0.0));

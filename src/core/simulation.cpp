@@ -436,6 +436,7 @@ void Simulation::integrateFor() {
   const double alpha = localDamping;
   const bool viscous = viscousDamping > 0.0;
   const double h = dt;
+  const bool gravityOn = gravity.squaredNorm() > 0.0;
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   // Periodic cell: particles move with the homogeneous flow too, x <- x + v h + M x, the same map
   // M = exp(L h) - I that advanced H; the rebuild test measures displacements from where that flow
@@ -447,7 +448,7 @@ void Simulation::integrateFor() {
 
 #pragma omp for schedule(static)
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
-  double work = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
+  double work = 0.0, gravityWork = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
   for (std::size_t i = sums.begin(chunk); i < sums.end(chunk); ++i) {
     gatherParticle(i);
     // Cundall local damping per component, against the sign of the current (mid-step) velocity.
@@ -500,6 +501,8 @@ void Simulation::integrateFor() {
     work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
     if constexpr (Periodic) x[i] += v[i] * h + flowStep * x[i];
     else x[i] += v[i] * h;
+    // Gravity's work is exact for the leapfrog: the particle moves by v h under the constant m g.
+    if (gravityOn) gravityWork += particles.mass[i] * gravity.dot(v[i]) * h;
     if (!xBuild.empty()) {
       if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
       else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
@@ -515,6 +518,7 @@ void Simulation::integrateFor() {
   sums.at(chunk, kDampingWork) = work;
   sums.at(chunk, kDisp2) = maxDisp2;
   sums.at(chunk, kBadParticle) = badParticle;
+  sums.at(chunk, kGravityWork) = gravityWork;
   }
   serial([&] { finishIntegration<Periodic>(deformation); });
 }
@@ -526,6 +530,7 @@ void Simulation::finishIntegration(const Mat3& deformation) {
   auto& v = particles.velocity;
   auto& w = particles.angularVelocity;
   energy.damping -= sums.total(kDampingWork);
+  if (gravity.squaredNorm() > 0.0) energy.gravityWork += sums.total(kGravityWork);
   const double maxDisp2 = std::max(0.0, sums.maxOf(kDisp2));
   const double bad = sums.minOf(kBadParticle);
   if (std::isfinite(bad)) {

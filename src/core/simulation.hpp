@@ -33,6 +33,7 @@ struct EnergyLedger {
   double rolling = 0.0;
   double damping = 0.0;       // local or viscous damping of the particles, and Hertz–Mindlin's dashpots
   double boundaryWork = 0.0;  // work done on the particles by the walls or the deforming cell
+  double gravityWork = 0.0;   // work done on the particles by gravity, sum of m g . dx (-dE_potential)
 };
 
 // The engine stage that failed during a step, shared by the threads of the step's team (an atomic,
@@ -141,6 +142,7 @@ class Simulation {
     kDampingWork = 0,  // work of the damping forces
     kDisp2,            // largest squared displacement since the list was built
     kBadParticle,      // first particle that went bad (+inf when none)
+    kGravityWork,      // work of gravity, m g . dx (summed only when gravity is on)
     kIntegrateSums,
   };
   ChunkedSums pairSums_, wallSums_, eeSums_, seSums_, ewSums_, integrateSums_;

@@ -107,7 +107,7 @@ void Simulation::validateState() const {
   if (!finiteIn(servo.gain, 0.0, 1.0) || !finiteIn(servo.integralSteps, 0.0, 1e300) || !finiteIn(servo.maxSpeed, 0.0, 1e300))
     bad("servo settings not finite or out of range");
   if (!std::isfinite(energy.slip) || !std::isfinite(energy.rolling) || !std::isfinite(energy.damping) ||
-      !std::isfinite(energy.boundaryWork) || !gravity.allFinite())
+      !std::isfinite(energy.boundaryWork) || !std::isfinite(energy.gravityWork) || !gravity.allFinite())
     bad("energy ledger or gravity not finite");
   if (!finiteIn(localDamping, 0.0, 1.0) || !finiteIn(viscousDamping, 0.0, 1e300)) bad("damping out of range");
   if (stepCount < 0 || !finiteIn(time, 0.0, 1e300)) bad("step count or time negative or not finite");

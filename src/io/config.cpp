@@ -195,7 +195,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"sample",
        {"n_particles", "grading", "density", "e0", "seed", "prep_friction_deg", "e0_tolerance", "initial_void_ratio",
         "packing", "prep_stiffness_factor", "prep_ramp_steps", "prep_damping", "method", "growth_rate",
-        "lattice_jitter", "shape", "packing_friction_deg"}},
+        "lattice_jitter", "shape", "packing_friction_deg", "drop_height", "gravity"}},
       {"contact",
        {"model", "young", "poisson", "friction_deg", "beta", "eta", "wall_friction_deg", "moment_limit", "kn",
         "rolling_friction", "sphericity", "shear_modulus", "rolling", "restitution"}},
@@ -501,7 +501,7 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   static const std::set<std::string> preparation{
       "sample.e0",           "sample.e0_tolerance", "sample.prep_friction_deg", "sample.initial_void_ratio",
       "sample.prep_stiffness_factor", "sample.prep_ramp_steps", "sample.prep_damping", "sample.method",
-      "sample.growth_rate",  "sample.lattice_jitter", "sample.shape"};
+      "sample.growth_rate",  "sample.lattice_jitter", "sample.shape", "sample.drop_height"};
   if (packing && (preparation.count(key) || key.rfind("sample.shape.", 0) == 0))
     return "not used with sample.packing (a packing file is taken as it is: no preparation)";
   if (!packing && key == "sample.packing_friction_deg")
@@ -510,9 +510,13 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "{ type = \"packing\" } needs sample.packing";
   if (key == "sample.growth_rate" && method != "growth")
     return "only used with sample.method = \"growth\"; " + here("sample.method", method);
+  if (key == "sample.prep_friction_deg" && method == "deposition") return "";  // the friction of the rain
   if ((key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg") && !searched)
-    return "only used with sample.method = \"compaction\" or \"loose-moment-free\" (a frictionless " + method +
+    return "only used with sample.method = \"compaction\" or \"loose-moment-free\" (" +
+           (method == "deposition" ? std::string("a deposited sample") : "a frictionless " + method) +
            " reaches its own e0); " + here("sample.method", method);
+  if (key == "sample.drop_height" && method != "deposition")
+    return "only used with sample.method = \"deposition\"; " + here("sample.method", method);
   if (key == "sample.initial_void_ratio" && method == "lattice")
     return "not used with sample.method = \"lattice\" (no loose placement)";
   if (key.rfind("sample.shape.", 0) == 0 && key != "sample.shape.type" && c.sample.shape.type != "ellipsoid")
@@ -829,7 +833,27 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
   c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
-  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice", "loose-moment-free"});
+  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice", "loose-moment-free", "deposition"});
+  c.sample.dropHeight = s.number("drop_height", c.sample.dropHeight, 0.0, 10.0, false, false,
+                                 "must be in [0, 10] [m] (free fall of the lowest grains of the cloud above the floor)");
+  if (const toml::node* n = s.raw("gravity")) {
+    const std::string key = s.path("gravity");
+    const std::vector<double> g = s.numbers(*n, key);
+    if (g.size() != 3) fail(key, show(*n), "must be an array of three numbers [gx, gy, gz] [m/s^2]");
+    const double norm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (norm > 1000.0) fail(key, show(*n), "|g| must be <= 1000 m/s^2 (about 100 times the Earth's)");
+    c.sample.gravity = std::array<double, 3>{g[0], g[1], g[2]};
+  }
+  if (c.sample.method == "deposition") {
+    if (!c.sample.gravity) c.sample.gravity = std::array<double, 3>{0.0, 0.0, -9.81};
+    const auto& g = *c.sample.gravity;
+    if (!(g[0] == 0.0 && g[1] == 0.0 && g[2] < 0.0))
+      fail("sample.gravity", fmt::format("[{}, {}, {}]", g[0], g[1], g[2]),
+           "sample.method = \"deposition\" rains the grains down the z axis onto the floor: allowed [0, 0, -g] with g > 0 "
+           "(default [0, 0, -9.81])");
+    if (c.sample.shape.type == "ellipsoid")
+      fail("sample.method", "\"deposition\"", "is for spheres; ellipsoids: \"compaction\", \"growth\" or \"lattice\"");
+  }
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
@@ -931,6 +955,12 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     c.test.type = *lab::parseTestType(type);  // one of names
   }
   c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
+  if (c.test.boundary == "periodic" && c.sample.gravity)
+    fail("sample.gravity", fmt::format("[{}, {}, {}]", (*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]),
+         c.sample.method == "deposition"
+             ? std::string("sample.method = \"deposition\" needs a floor (grains settle on the box's floor); allowed: test.boundary = \"walls\"")
+             : std::string("not with test.boundary = \"periodic\" (a cell has no floor: gravity would accelerate the "
+                           "whole sample); allowed: test.boundary = \"walls\""));
   if (lab::info(c.test.type).periodicOnly && c.test.boundary != "periodic")
     fail("test.type", fmt::format("\"{}\"", lab::name(c.test.type)),
          "needs test.boundary = \"periodic\" (a wall box has no shearing walls)");
@@ -1118,6 +1148,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(sample, "sample", "method", c.sample.method);
   put(sample, "sample", "growth_rate", c.sample.growthRate);
   put(sample, "sample", "lattice_jitter", c.sample.latticeJitter);
+  put(sample, "sample", "drop_height", c.sample.dropHeight);
+  if (c.sample.gravity) put(sample, "sample", "gravity", toml::array{(*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]});
   put(sample, "sample", "shape", shape);
   if (c.sample.packingFrictionDeg) put(sample, "sample", "packing_friction_deg", *c.sample.packingFrictionDeg);
   if (c.sample.prepFrictionDeg) put(sample, "sample", "prep_friction_deg", *c.sample.prepFrictionDeg);

@@ -51,6 +51,7 @@ TimeseriesColumns timeseriesColumns(const lab::RunConfig& config) {
   c.loops = !config.test.unloadReloadAt.empty();
   c.stressPath = config.test.type == lab::TestType::StressPath;
   c.cyclicShear = config.test.type == lab::TestType::CyclicSimpleShear;
+  c.gravity = config.sample.gravity.has_value();
   return c;
 }
 
@@ -70,6 +71,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   if (columns.reversing) s += ",load_direction";
   if (columns.stressPath) s += ",s,segment";
   if (columns.cyclicShear) s += ",amplitude";
+  if (columns.gravity) s += ",W_gravity";
   s += '\n';
   auto put = [&](long step, double v) {
     if (!std::isfinite(v))
@@ -109,6 +111,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
       s += fmt::format(",{}", r.pathSegment);
     }
     if (columns.cyclicShear) s += fmt::format(",{}", r.pathSegment);
+    if (columns.gravity) put(r.step, r.workGravity);
     s += '\n';
   }
   return s;

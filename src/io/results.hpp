@@ -30,6 +30,7 @@ struct TimeseriesColumns {
   bool stressPath = false;
   // Cyclic simple shear: amplitude (1-based index into test.shear_strain_amplitudes).
   bool cyclicShear = false;
+  bool gravity = false;  // sample.gravity given: the work of gravity, W_gravity
 };
 TimeseriesColumns timeseriesColumns(const lab::RunConfig& config);
 

@@ -36,6 +36,15 @@ class WallBoundary final : public BoundaryControl {
     checkAxis(axis);
     if (side != 0 && side != 1) throw std::invalid_argument(fmt::format("side = {}; allowed: 0 (lower), 1 (upper)", side));
     Wall& w = sim_.box.walls[WallBox::index(axis, side)];
+    // Under gravity the face the grains weigh on is the pedestal and stays put: were it servoed too,
+    // it would carry the weight above the other face's stress and the sample would sink at the
+    // servo's speed. The sample is held by the opposite face alone.
+    const double g = sim_.gravity[axis];
+    if ((g < 0.0 && side == 0) || (g > 0.0 && side == 1)) {
+      w.control = WallControl::Fixed;
+      w.velocity = 0.0;
+      return;
+    }
     w.control = WallControl::Stress;
     w.targetStress = target;
   }

@@ -1,6 +1,7 @@
 #include "lab/placement.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <numeric>
@@ -11,23 +12,28 @@ namespace grainlab::lab {
 
 namespace {
 
-bool tryPlace(const std::vector<double>& radii, double boxSide, bool periodic, Rng& rng, std::vector<Vec3>& pos) {
+// Random sequential placement in the box [0, extent] (a periodic cell: the cube of side extent[0]).
+bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodic, Rng& rng, std::vector<Vec3>& pos) {
   const double rMax = radii.front();
   const double cellSide = 2.0 * rMax;
-  const int dim = SpatialGrid::cellsAlong(boxSide, cellSide);
+  const double boxSide = extent[0];  // the period of a cell
+  std::array<int, 3> dim{};
+  for (int a = 0; a < 3; ++a) dim[a] = SpatialGrid::cellsAlong(extent[a], cellSide);
   // In a cell, the grid's cells tile the period exactly, so that the wrapped block finds images.
-  const double side = periodic ? boxSide / dim : cellSide;
+  const double side = periodic ? boxSide / dim[0] : cellSide;
   SpatialGrid grid;
-  grid.reset({dim, dim, dim});
+  grid.reset({dim[0], dim[1], dim[2]});
   pos.assign(radii.size(), Vec3::Zero());
   for (std::size_t i = 0; i < radii.size(); ++i) {
     const double r = radii[i];
     bool placed = false;
     for (int attempt = 0; attempt < 2000 && !placed; ++attempt) {
-      const double lo = periodic ? 0.0 : r, hi = periodic ? boxSide : boxSide - r;
-      const Vec3 x(rng.uniform(lo, hi), rng.uniform(lo, hi), rng.uniform(lo, hi));
+      // Drawn z first, then y, then x: the order in which g++ evaluated the three draws of the
+      // earlier Vec3(u(), u(), u()), kept so that every seed places its grains where it did.
+      Vec3 x;
+      for (int a = 2; a >= 0; --a) x[a] = rng.uniform(periodic ? 0.0 : r, periodic ? boxSide : extent[a] - r);
       SpatialGrid::Cell c{};
-      for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(x[a], 0.0, side, dim);
+      for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(x[a], 0.0, side, dim[a]);
       bool free = true;
       auto check = [&](std::uint32_t j, const Vec3& image) {
         const double reach = r + radii[j];
@@ -52,6 +58,27 @@ bool tryPlace(const std::vector<double>& radii, double boxSide, bool periodic, R
   return true;
 }
 
+// Adds the spheres renumbered in cell order (z, y, x) of cells about one large diameter wide, so
+// that neighbours in space are neighbours in memory.
+void addInCellOrder(const std::vector<Vec3>& pos, const std::vector<double>& radii, const Vec3& extent, double density,
+                    Simulation& sim) {
+  const double dMax = 2.0 * radii.front();
+  std::array<int, 3> dim{};
+  for (int a = 0; a < 3; ++a) dim[a] = SpatialGrid::cellsAlong(extent[a], dMax);
+  SpatialGrid grid;
+  grid.reset({dim[0], dim[1], dim[2]});
+  std::vector<std::size_t> order(radii.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](std::size_t i) {
+    SpatialGrid::Cell c{};
+    for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(pos[i][a], 0.0, dMax, dim[a]);
+    return grid.cellIndex(c);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  sim.particles = Particles{};
+  for (std::size_t i : order) sim.particles.addSphere(pos[i], radii[i], density);
+}
+
 }  // namespace
 
 void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim) {
@@ -66,24 +93,35 @@ void placeLoose(std::vector<double> diameters, double density, double voidRatio,
   double side = std::cbrt(solid * (1.0 + voidRatio));
   side = std::max(side, 2.0 * diameters.front());
   std::vector<Vec3> pos;
-  while (!tryPlace(radii, side, periodic, rng, pos)) side *= 1.05;
+  while (!tryPlace(radii, Vec3::Constant(side), periodic, rng, pos)) side *= 1.05;
 
-  // Renumber in cell order (z, y, x) of cells about one large diameter wide.
-  const int dim = SpatialGrid::cellsAlong(side, diameters.front());
-  SpatialGrid grid;
-  grid.reset({dim, dim, dim});
-  std::vector<std::size_t> order(radii.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](std::size_t i) {
-    SpatialGrid::Cell c{};
-    for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(pos[i][a], 0.0, diameters.front(), dim);
-    return grid.cellIndex(c);
-  };
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
-  sim.particles = Particles{};
-  for (std::size_t i : order) sim.particles.addSphere(pos[i], radii[i], density);
+  addInCellOrder(pos, radii, Vec3::Constant(side), density, sim);
   if (periodic) sim.cell.setBox(Vec3::Constant(side));
   else sim.box.setBounds(Vec3::Zero(), Vec3::Constant(side));
+}
+
+ColumnPlacement placeColumn(std::vector<double> diameters, double density, double voidRatio, double bedVoidRatio,
+                            double dropHeight, Rng& rng, Simulation& sim) {
+  std::sort(diameters.begin(), diameters.end(), std::greater<>());
+  std::vector<double> radii(diameters.size());
+  double solid = 0.0;
+  for (std::size_t i = 0; i < diameters.size(); ++i) {
+    radii[i] = 0.5 * diameters[i];
+    solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
+  }
+  // A square footprint on which the settled bed (at about bedVoidRatio) is roughly a cube.
+  const double width = std::max(std::cbrt(solid * (1.0 + bedVoidRatio)), 2.0 * diameters.front());
+  double height = std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * diameters.front());
+  std::vector<Vec3> pos;
+  while (!tryPlace(radii, Vec3(width, width, height), false, rng, pos)) height *= 1.05;
+  for (Vec3& x : pos) x.z() += dropHeight;
+  addInCellOrder(pos, radii, Vec3(width, width, height + dropHeight), density, sim);
+  sim.box.setBounds(Vec3::Zero(), Vec3(width, width, height + dropHeight));
+  ColumnPlacement out;
+  out.width = width;
+  out.cloudHeight = height;
+  out.cloudSolidFraction = solid / (width * width * height);
+  return out;
 }
 
 void placeLattice(int n, double d, double density, Simulation& sim) {

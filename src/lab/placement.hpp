@@ -15,6 +15,18 @@ namespace grainlab::lab {
 // as sim.boundary says.
 void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim);
 
+// sample.method = "deposition": spheres placed at random, without overlaps, in a column (a cloud of
+// void ratio voidRatio) above the floor of a wall box with a square footprint on which a bed of
+// about bedVoidRatio would be a cube; the cloud's lowest point is dropHeight above the floor. The
+// box (walls on its faces) encloses the cloud; the column grows by 5 % if a sphere finds no room.
+struct ColumnPlacement {
+  double width = 0.0;               // side of the footprint [m]
+  double cloudHeight = 0.0;         // height of the cloud [m]
+  double cloudSolidFraction = 0.0;  // solid volume / cloud volume
+};
+ColumnPlacement placeColumn(std::vector<double> diameters, double density, double voidRatio, double bedVoidRatio,
+                            double dropHeight, Rng& rng, Simulation& sim);
+
 // [O] §5.1: n^3 equal spheres of diameter d on a simple cubic lattice of spacing d (just touching),
 // filling the cube of side n d: the cell (periodic) or the box of walls.
 void placeLattice(int n, double d, double density, Simulation& sim);

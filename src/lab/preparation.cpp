@@ -25,6 +25,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   sim_.localDamping = config_.sample.prepDamping;
   setFriction(muDeg);
   if (config_.sample.method == "growth") steps += growRadii();
+  if (config_.sample.method == "deposition") steps += deposit();
   // "loose-moment-free": no contact moments while the skeleton forms (Kozicki–Donze: no rolling
   // stiffness; rolling-linear: no rolling friction); configureSolver() below and the saved rolling
   // friction switch them on again, from zero moment, before the full-stiffness equilibrium.
@@ -37,7 +38,8 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   const bool searched = config_.sample.method == "compaction" || momentFree;
   steps += consolidate(config_.test.confiningPressure,
                        searched ? fmt::format("compaction (mu_prep {:.1f} deg{})", muDeg, momentFree ? ", no moments" : "")
-                                : std::string("isotropic compression"));
+                       : config_.sample.method == "deposition" ? std::string("consolidation of the deposited bed")
+                                                               : std::string("isotropic compression"));
   // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
   // from the compressed lattice is not affine. sample.lattice_jitter moves every grain of the
   // compressed lattice by up to that fraction of its diameter along each axis (small beside the
@@ -88,7 +90,10 @@ PreparationResult Laboratory::prepare() {
     return e;
   };
 
-  if (config_.sample.method != "compaction" && config_.sample.method != "loose-moment-free") {
+  if (config_.sample.method == "deposition") {
+    // The grains rain and settle at sample.prep_friction_deg when given, else at the contact friction.
+    trial(config_.sample.prepFrictionDeg.value_or(config_.contact.frictionDeg));
+  } else if (config_.sample.method != "compaction" && config_.sample.method != "loose-moment-free") {
     trial(0.0);  // frictionless growth or lattice: the e0 reached is the result, not a target
   } else if (config_.sample.prepFrictionDeg) {
     trial(*config_.sample.prepFrictionDeg);
@@ -134,6 +139,7 @@ PreparationResult Laboratory::prepare() {
   }
   sim_ = std::move(best);
   result.growth = growthCurve_;
+  result.deposition = deposition_;
   records_.reset(sim_);
   result.state = equilibriumState();
   result.coordination = coordination(microNetwork(sim_));
@@ -145,7 +151,17 @@ void Laboratory::placeSample(PreparationResult& result) {
   const std::vector<double> diameters = sampleDiameters(config_.sample.grading, config_.sample.nParticles, rng);
   result.grading = gradingStats(diameters);
   d50_ = result.grading.d50;
-  if (config_.sample.method == "lattice") {
+  if (config_.sample.method == "deposition") {
+    // The bed's footprint is sized for a cube at e ~ 0.7 (a loose deposit); the sample is as tall as
+    // its grains settle.
+    const ColumnPlacement column = placeColumn(diameters, config_.sample.density, config_.sample.initialVoidRatio, 0.7,
+                                               config_.sample.dropHeight, rng, sim_);
+    deposition_ = DepositionReport{};
+    deposition_->dropHeight = config_.sample.dropHeight;
+    deposition_->cloudHeight = column.cloudHeight;
+    deposition_->cloudSolidFraction = column.cloudSolidFraction;
+    deposition_->width = column.width;
+  } else if (config_.sample.method == "lattice") {
     // Equal spheres of the grading's d50 ([O]'s N = n^3 equal grains).
     const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(config_.sample.nParticles))));
     placeLattice(n, result.grading.d50, config_.sample.density, sim_);
@@ -168,6 +184,50 @@ void Laboratory::placeSample(PreparationResult& result) {
           "under twice the interaction range {:.3g} m); allowed: enough particles for >= ~3 largest "
           "diameters per side", config_.sample.nParticles, expected, need));
   }
+}
+
+long Laboratory::deposit() {
+  // Every wall still: the grains fall from rest and settle on the floor.
+  for (int a = 0; a < 3; ++a) boundary_->fix(a);
+  const double unbTol = config_.solver.unbalancedTolerance;
+  const double work0 = sim_.energy.gravityWork;
+  const std::string phase = "deposition (rain and settling)";
+  Pipeline pipeline(sim_);
+  pipeline.addAfter("settling check", [&] {
+    const long steps = pipeline.steps();
+    // Grains in free fall have no contact and a net force m g: the ratio is large until every
+    // grain rests on the bed.
+    // A violent collision in the falling cloud can make the ratio small too: the bed has settled
+    // when, besides, the grains' kinetic energy is below 1e-3 of the work gravity has done.
+    const double unb = unbalancedForceRatio(sim_);
+    const double released = sim_.energy.gravityWork - work0;
+    if (unb < unbTol && sim_.touchingPairs() > 0 && kineticEnergy(sim_) < kSettledKineticFraction * released) {
+      pipeline.stop();
+      return;
+    }
+    if (progress_ && steps % 1000 == 0)
+      progress_(phase, std::clamp(1.0 - std::log10(std::max(unb / unbTol, 1.0)) / 3.0, 0.0, 0.99), steps);
+    if (steps >= config_.solver.maxSteps)
+      throw SimulationError(fmt::format(
+          "{}: the grains have not settled after {} steps (unbalanced force ratio {:.3g}); raise solver.max_steps, "
+          "lower sample.drop_height or check the parameters", phase, steps, unb));
+  }, Pipeline::Trigger::period(100));
+  const long steps = pipeline.run();
+  if (progress_) progress_(phase, 1.0, steps);
+  // The top platen comes down onto the bed's highest grain.
+  const Particles& P = sim_.particles;
+  double top = sim_.box.lower(2).position;
+  for (std::size_t i = 0; i < P.size(); ++i) top = std::max(top, P.position[i].z() + P.radius[i]);
+  sim_.box.upper(2).position = top;
+  sim_.initialise(config_.solver.skinFraction);
+  deposition_->bedHeight = top - sim_.box.lower(2).position;
+  deposition_->settledVoidRatio = voidRatio(sim_);
+  deposition_->settledCoordination = coordinationNumber(sim_);
+  const MicroAnalysis bed = micro_.analyse(microNetwork(sim_));
+  if (bed.ar) deposition_->settledFabricZz = bed.ar->tensor(2, 2);
+  deposition_->gravityWork = sim_.energy.gravityWork - work0;
+  deposition_->steps = steps;
+  return steps;
 }
 
 long Laboratory::growShapes() {

@@ -49,6 +49,7 @@ struct Record {
   double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
          dissipDamping = 0.0;
+  double workGravity = 0.0;  // work of gravity on the particles [J] (sample.gravity)
   // Periodic cell: logarithmic axial strain -ln(H_zz/H0_zz), and the skew part of the contact
   // stress relative to p (a check: zero without contact moments at equilibrium).
   double eps1Log = 0.0, stressSkew = 0.0;
@@ -97,6 +98,20 @@ struct GrowthStage {
   double packingFraction = 0.0;  // solid volume / cell volume
 };
 
+// sample.method = "deposition": the rain and settling, before the platen and the servos take over.
+struct DepositionReport {
+  double dropHeight = 0.0;          // [m] free fall of the cloud's lowest grains
+  double cloudHeight = 0.0;         // [m]
+  double cloudSolidFraction = 0.0;  // of the cloud at release
+  double width = 0.0;               // [m] side of the square footprint
+  double bedHeight = 0.0;           // [m] highest grain top after settling
+  double settledVoidRatio = 0.0;    // of the settled bed (box footprint x bed height), before consolidation
+  double settledCoordination = 0.0; // Z of the settled bed
+  std::optional<double> settledFabricZz;  // a_r_zz = 15/2 (R_zz - 1/3) of the settled bed (null: no contact)
+  double gravityWork = 0.0;         // [J] work of gravity during the rain and settling
+  long steps = 0;
+};
+
 struct PreparationResult {
   double e0 = 0.0;                          // reached
   std::vector<GrowthStage> growth;          // the shape growth curve (ellipsoids), stage 0 = spheres
@@ -108,6 +123,7 @@ struct PreparationResult {
   // Coordination of the prepared sample (docs/micromechanics.md §1): Z over every particle, Z_mech
   // over the non-rattlers (null when every grain is a rattler).
   Coordination coordination{};
+  std::optional<DepositionReport> deposition;  // sample.method = "deposition"
 };
 
 struct ShearResult {
@@ -255,6 +271,12 @@ class Laboratory {
   void setFriction(double deg) { sim_.model.tanFriction = std::tan(degToRad(deg)); }
   long rampStiffness();
   long growRadii();
+  // sample.method = "deposition": walls fixed, the cloud falls and settles under gravity (until the
+  // unbalanced-force ratio is below solver.unbalanced_tolerance); then the top platen is brought
+  // down onto the bed. Fills deposition_.
+  long deposit();
+  static constexpr double kSettledKineticFraction = 1e-3;
+  std::optional<DepositionReport> deposition_;  // of the last deposit(); preparation only
   // Frictionless growth of the grains chosen to be ellipsoids from their equal-volume spheres to
   // sample.shape, in steps of eccentricity with the boundary holding p after each ([O] §5.2-5.3).
   long growShapes();

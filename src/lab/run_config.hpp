@@ -2,6 +2,7 @@
 // The full description of a laboratory run. Every field has a default; io/config.cpp fills it from
 // TOML and validates it, and writes it back out with every default resolved. Units SI, angles deg.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -86,6 +87,14 @@ struct SampleConfig {
   std::string method = "compaction";
   double growthRate = 2e-5;           // relative radius growth per step (method "growth")
   double latticeJitter = 0.0;         // lattice: random offsets of the compressed lattice, fraction of d
+  // "deposition": the grains, placed at random in a tall column (a cloud at initial_void_ratio), fall
+  // under gravity onto the floor of a box with fixed walls and settle; then the top platen and the
+  // side walls take over and consolidate to the confining pressure (docs/lab.md, preparation).
+  // drop_height [m]: free fall of the cloud's lowest grains above the floor.
+  double dropHeight = 0.0;
+  // Gravity [m/s^2], every protocol (walls only): none unless given; "deposition" defaults to
+  // (0, 0, -9.81) and needs it along -z.
+  std::optional<std::array<double, 3>> gravity;
   ShapeConfig shape;
 };
 

@@ -76,9 +76,12 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.dissipSlip = sim_.energy.slip;
   r.dissipRoll = sim_.energy.rolling;
   r.dissipDamping = sim_.energy.damping;
-  if (shear_.started && r.workBoundary > 0.0) {
+  r.workGravity = sim_.energy.gravityWork;
+  // External work: the boundary's, and gravity's (zero without gravity, so the sum is W_boundary).
+  const double external = r.workBoundary + r.workGravity;
+  if (shear_.started && external > 0.0) {
     const double stored = (r.elastic - shear_.elastic0) + (r.kinetic - shear_.kinetic0);
-    r.energyResidual = (r.workBoundary - stored - r.dissipSlip - r.dissipRoll - r.dissipDamping) / r.workBoundary;
+    r.energyResidual = (external - stored - r.dissipSlip - r.dissipRoll - r.dissipDamping) / external;
   } else {
     r.energyResidual = std::numeric_limits<double>::quiet_NaN();
   }

@@ -85,7 +85,8 @@ static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
                              std::unique_ptr<lab::ShearProtocol>, std::unique_ptr<lab::BoundaryControl>,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
-                             lab::MicroColumnSet, double, std::vector<lab::GrowthStage>>(),
+                             lab::MicroColumnSet, double, std::vector<lab::GrowthStage>,
+                             std::optional<lab::DepositionReport>>(),
               "Laboratory changed: update Laboratory::saveState/loadState and this list");
 static_assert(std::is_trivially_copyable_v<Wall> && std::is_trivially_copyable_v<lab::Record> &&
               std::is_trivially_copyable_v<contact::SphereContactModel>);
