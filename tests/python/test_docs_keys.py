@@ -121,6 +121,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "cyclic-simple-shear": '[test]\ntype = "cyclic-simple-shear"\nboundary = "periodic"\n',
         "dt": '[solver]\ndt = 1e-7\n',
         "hertz-mindlin": '[contact]\nmodel = "hertz-mindlin"\n',
+        "deposition": '[sample]\nmethod = "deposition"\n',
     }
     printed = {}
     for name, text in configs.items():
@@ -204,14 +205,14 @@ def test_timeseries_columns_are_documented_in_order(short_run):
     header = (short_run / "timeseries.csv").read_text().splitlines()[0].split(",")
     # The columns of the other tests, where results.cpp inserts them: before energy_residual.
     src = read("src", "io", "results.cpp")
-    extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([a-z0-9_,]+)";', src))
+    extra = dict(re.findall(r'if \(columns\.(\w+)\) s \+= ",([A-Za-z0-9_,]+)";', src))
     assert set(extra) == {"periodic", "simpleShear", "trueTriaxial", "loops", "undrained", "cyclic", "reversing",
-                          "stressPath", "cyclicShear"}, extra
+                          "stressPath", "cyclicShear", "gravity"}, extra
     i = header.index("energy_residual")
     # The unload-reload column and the undrained, cyclic and reversing tests' columns come last,
     # after the micromechanics columns.
     expected = (header[:i] + [n for k in ("periodic", "simpleShear", "trueTriaxial") for n in extra[k].split(",")]
-                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing", "stressPath", "cyclicShear") for n in extra[k].split(",")])
+                + header[i:] + [n for k in ("loops", "undrained", "cyclic", "reversing", "stressPath", "cyclicShear", "gravity") for n in extra[k].split(",")])
     rows = table_rows(section(read("docs", "laboratory.md"), "3.2 Time series columns"))
     documented = [n for cells in rows[2:] for n in names_in(cells[0])]
     assert documented == expected
@@ -221,6 +222,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "mu_r_mean", "mu_r_min", "mu_r_max",   # rolling-linear runs
     "G_MPa", "final_shear_strain",         # simple shear
     "growth_curve",                        # ellipsoid shape growth
+    "deposition",                          # sample.method = "deposition"
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
     # undrained tests
