@@ -258,7 +258,11 @@ std::string didYouMean(const std::string& table, const std::string& key) {
 [[noreturn]] void failUnknown(const std::string& table, const std::string& key, const toml::node& value) {
   std::string known;
   for (const auto& k : *keysOf(table)) known += (known.empty() ? "" : ", ") + k;
-  fail(table + "." + key, show(value),
+  // The value of an unknown key matters little: cut shorter than elsewhere, so that the list of
+  // known keys fits in one readable line.
+  std::ostringstream os;
+  writeValue(os, value);
+  fail(table + "." + key, printable(os.str(), 32),
        fmt::format("unknown key{}; known keys in {}: {}", didYouMean(table, key),
                    table.find('.') == std::string::npos ? "[" + table + "]" : table, known));
 }
@@ -851,14 +855,14 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
       fail("sample.gravity", fmt::format("[{}, {}, {}]", g[0], g[1], g[2]),
            "sample.method = \"deposition\" rains the grains down the z axis onto the floor: allowed [0, 0, -g] with g > 0 "
            "(default [0, 0, -9.81])");
-    if (c.sample.shape.type == "ellipsoid")
-      fail("sample.method", "\"deposition\"", "is for spheres; ellipsoids: \"compaction\", \"growth\" or \"lattice\"");
   }
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
                                     "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
+  if (c.sample.method == "deposition" && c.sample.shape.type == "ellipsoid")
+    fail("sample.method", "\"deposition\"", "is for spheres only; allowed with sample.shape.type = \"ellipsoid\": \"compaction\", \"growth\" or \"lattice\"");
   // A packing file brings its own grains: the grading of the run is the packing's.
   if (!c.sample.packing.empty()) c.sample.grading = lab::GradingConfig::ofPacking();
   if (c.sample.latticeJitter > 0.0 && c.sample.method != "lattice")
