@@ -97,7 +97,7 @@ class RunStore:
             with open(os.path.join(run_dir, "summary.json")) as f:
                 summary = json.load(f)
         if code == 0 and summary.get("status") == "completed":
-            values, curves, problem = self.problem.outputs(run_dir, summary)
+            values, curves, problem = self.problem.outputs(run_dir, summary, job["condition"])
         else:
             problem = f"run failed (exit {code}): {summary.get('error', 'see the log')}"
         record = {"name": job["name"], "sets": job["param_sets"], "seed": job["seed"], "exit_code": code,
@@ -137,16 +137,18 @@ class Evaluator:
         missing = []
         stored = {}
         for name, u in points:
-            param_sets = self.space.sets(u)
             stored[name] = 0
-            for seed in self.seeds:
-                run = f"{name}_seed{seed}"
-                if self.store.lookup(run, param_sets, seed) is None:
-                    out = os.path.join(self.store.dir, run)
-                    missing.append(dict(self.job_base, name=run, out=out, seed=seed, param_sets=param_sets,
-                                        sets=param_sets + [f"sample.seed={seed}"] + RUN_OUTPUT_SETS))
-                else:
-                    stored[name] += 1
+            for condition in self.problem.conditions:
+                param_sets = self.space.sets(u) + condition["sets"]
+                for seed in self.seeds:
+                    run = self.run_name(name, condition, seed)
+                    if self.store.lookup(run, param_sets, seed) is None:
+                        out = os.path.join(self.store.dir, run)
+                        missing.append(dict(self.job_base, name=run, out=out, seed=seed, param_sets=param_sets,
+                                            condition=condition["id"],
+                                            sets=param_sets + [f"sample.seed={seed}"] + RUN_OUTPUT_SETS))
+                    else:
+                        stored[name] += 1
         if missing:
             for job in missing:  # a folder left by an interrupted run is never mixed with a new one
                 if os.path.exists(job["out"]):
@@ -155,12 +157,24 @@ class Evaluator:
             self.runner.run(missing, self.store.record)
         return [self._assemble(name, u, kind, stored[name]) for name, u in points]
 
+    @staticmethod
+    def run_name(name, condition, seed):
+        """e0003_seed2, or e0003_p100kPa_seed2 with several conditions (pressures)."""
+        return f"{name}_{condition['id']}_seed{seed}" if condition["id"] else f"{name}_seed{seed}"
+
     def _assemble(self, name, u, kind, cached):
-        records = [self.store.records[f"{name}_seed{seed}"] for seed in self.seeds]
+        # One record per seed: the runs of every condition of that seed, merged (their targets and
+        # curves are disjoint), so that seed means and scatter are over the seeds as before.
+        per_condition = [[self.store.records[self.run_name(name, c, seed)] for c in self.problem.conditions]
+                         for seed in self.seeds]
+        records = [{"name": "+".join(r["name"] for r in runs),
+                    "problem": next((r["problem"] for r in runs if r["problem"]), None),
+                    "values": {k: v for r in runs for k, v in r["values"].items()},
+                    "curves": {k: v for r in runs for k, v in r["curves"].items()}} for runs in per_condition]
         problems = [r["problem"] for r in records if r["problem"]]
         evaluation = {"index": len(self.history), "name": name, "kind": kind, "u": [float(x) for x in u],
                       "parameters": dict(zip(self.space.keys, self.space.values(u))), "seeds": self.seeds,
-                      "runs": [r["name"] for r in records], "failed": problems[0] if problems else None,
+                      "runs": [r["name"] for runs in per_condition for r in runs], "failed": problems[0] if problems else None,
                       "objective": None, "objective_per_seed": None, "values": {}, "curves": {}}
         if not problems:
             per_seed_y = [self.problem.output_vector(r["values"], r["curves"]) for r in records]
@@ -187,7 +201,7 @@ class Evaluator:
             params = ", ".join(f"{k.split('.')[-1]}={v:.6g}" for k, v in evaluation["parameters"].items())
             state = f"FAILED ({evaluation['failed']}), penalty {evaluation['objective']:.4g}" if problems \
                 else f"objective {evaluation['objective']:.6g}"
-            reused = f" [{cached}/{len(self.seeds)} runs stored]" if cached else ""
+            reused = f" [{cached}/{len(self.seeds) * len(self.problem.conditions)} runs stored]" if cached else ""
             print(f"{name} ({kind}): {params} -> {state}{reused}", file=sys.stderr, flush=True)
         return evaluation
 

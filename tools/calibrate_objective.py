@@ -91,57 +91,75 @@ def numeric_keys(summary, prefix=""):
 
 
 class Problem:
-    """Targets, the laboratory curve on its grid, and the objective."""
+    """Targets, the laboratory curves on their grids, and the objective.
+
+    A target file may name several confining pressures (docs/calibration.md, "Several pressures"):
+    each is a condition, one run per condition and seed; every target and curve belongs to one
+    (its "condition" id, "" when the file names only the config's pressure). Targets are told apart
+    by their label t["key"] ("phi_peak_deg", or "phi_peak_deg@100kPa" with several pressures), the
+    value read from the summary is t["summary_key"]; curve quantities likewise ("q", "q@100kPa")."""
 
     def __init__(self, target):
         self.targets = target["targets"]
-        self.curve = target["curve"]
-        self.grid = None
+        curves = target.get("curves")
+        if curves is None:  # a calibration.json of one [curve], before several pressures
+            curves = [dict(target["curve"], label="curve", condition="")] if target.get("curve") else []
+        self.curves = curves
+        self.conditions = target.get("conditions") or [{"id": "", "confining_pressure": None, "sets": []}]
+        self.entries = []  # the curve quantities, flattened: label, column name, weight, scale, curve, grid
         self.lab = {}
-        if self.curve:
-            self.grid = np.linspace(self.curve["eps1_min"], self.curve["eps1_max"], self.curve["points"])
-            data = self.curve["data"]
-            for q in self.curve["quantities"]:
-                self.lab[q["name"]] = np.interp(self.grid, data["eps1"], data[q["name"]])
+        for c in curves:
+            grid = np.linspace(c["eps1_min"], c["eps1_max"], c["points"])
+            for q in c["quantities"]:
+                label = q.get("label", q["name"])
+                self.entries.append({"label": label, "name": q["name"], "weight": q["weight"], "scale": q["scale"],
+                                     "curve": c, "grid": grid})
+                self.lab[label] = np.interp(grid, c["data"]["eps1"], c["data"][q["name"]])
 
     def quantities(self):
-        return [q["name"] for q in self.curve["quantities"]] if self.curve else []
+        """The labels of the curve quantities (the keys of a run's curves)."""
+        return [e["label"] for e in self.entries]
 
-    def outputs(self, run_dir, summary):
-        """What one completed run gives: the target values and the curves on the grid.
-        Returns (values, curves, problem): problem names what could not be measured, or is None."""
+    def outputs(self, run_dir, summary, condition=""):
+        """What one completed run of a condition gives: its targets' values and its curves on their
+        grids. Returns (values, curves, problem): problem names what could not be measured, or is None."""
         values = {}
         problem = None
         for t in self.targets:
+            if t.get("condition", "") != condition:
+                continue
+            key = t.get("summary_key", t["key"])
             try:
-                v = summary_value(summary, t["key"])
+                v = summary_value(summary, key)
             except KeyError:
                 keys = numeric_keys(summary)
                 # The closest keys first: the whole list is cut to stay one readable line.
-                close = difflib.get_close_matches(t["key"], keys, n=3, cutoff=0.5)
+                close = difflib.get_close_matches(key, keys, n=3, cutoff=0.5)
                 hint = f"closest: {', '.join(close)}; " if close else ""
                 raise InputProblem(
-                    f"target error: target {t['key']!r}: not a numeric key of summary.json "
+                    f"target error: target {key!r}: not a numeric key of summary.json "
                     f"({hint}numeric keys: {', '.join(keys)[:600]})") from None
             values[t["key"]] = v
             if v is None:
                 problem = problem or f"{t['key']} was not measured (null)"
         curves = {}
-        if self.curve:
+        mine = [e for e in self.entries if e["curve"].get("condition", "") == condition]
+        if mine:
             series = read_timeseries(f"{run_dir}/timeseries.csv")
             eps1 = series["eps1"]
-            if eps1[-1] < self.grid[-1] * (1.0 - 1e-9):
-                problem = problem or f"the run ends at eps1 = {eps1[-1]:.4g} before the grid's {self.grid[-1]:.4g}"
-            for q in self.quantities():
-                curves[q] = np.interp(self.grid, eps1, simulated_quantity(series, q)).tolist()
+            for e in mine:
+                grid = e["grid"]
+                if eps1[-1] < grid[-1] * (1.0 - 1e-9):
+                    problem = problem or f"the run ends at eps1 = {eps1[-1]:.4g} before the grid's {grid[-1]:.4g}"
+                curves[e["label"]] = np.interp(grid, eps1, simulated_quantity(series, e["name"])).tolist()
         return values, curves, problem
 
     def residuals(self, values, curves):
         """The residual vector r of one set of outputs (seed-mean or a single seed)."""
         r = [math.sqrt(t["weight"]) * (values[t["key"]] - t["value"]) / t["scale"] for t in self.targets]
-        for q in (self.curve["quantities"] if self.curve else []):
-            factor = math.sqrt(q["weight"] / len(self.grid)) / q["scale"]
-            r += list(factor * (np.asarray(curves[q["name"]]) - self.lab[q["name"]]))
+        for e in self.entries:
+            factor = math.sqrt(e["weight"] / len(e["grid"])) / e["scale"]
+            r += list(factor * (np.asarray(curves[e["label"]]) - self.lab[e["label"]]))
         return np.asarray(r, dtype=float)
 
     def objective(self, values, curves):
@@ -153,15 +171,23 @@ class Problem:
     def output_scales(self):
         """Per residual entry: d r / d output (the weight over the scale)."""
         c = [math.sqrt(t["weight"]) / t["scale"] for t in self.targets]
-        for q in (self.curve["quantities"] if self.curve else []):
-            c += [math.sqrt(q["weight"] / len(self.grid)) / q["scale"]] * len(self.grid)
+        for e in self.entries:
+            c += [math.sqrt(e["weight"] / len(e["grid"])) / e["scale"]] * len(e["grid"])
         return np.asarray(c, dtype=float)
 
     def output_vector(self, values, curves):
         y = [values[t["key"]] for t in self.targets]
-        for q in self.quantities():
-            y += list(curves[q])
+        for e in self.entries:
+            y += list(curves[e["label"]])
         return np.asarray(y, dtype=float)
+
+    def entry_offsets(self):
+        """(entry, first index in the output vector) of every curve quantity."""
+        out, offset = [], len(self.targets)
+        for e in self.entries:
+            out.append((e, offset))
+            offset += len(e["grid"])
+        return out
 
 
 def read_timeseries(path):

@@ -95,10 +95,8 @@ def analyse(space, problem, best, neighbours, step):
     n_seeds = len(per_seed)
     table = {}
     rows = [(t["key"], [i], t["scale"]) for i, t in enumerate(problem.targets)]
-    offset = len(problem.targets)
-    for q in (problem.curve["quantities"] if problem.curve else []):
-        rows.append((f"curve:{q['name']}", list(range(offset, offset + len(problem.grid))), q["scale"]))
-        offset += len(problem.grid)
+    for e, offset in problem.entry_offsets():
+        rows.append((f"curve:{e['label']}", list(range(offset, offset + len(e["grid"]))), e["scale"]))
     for name, idx, scale in rows:
         entry = {}
         for i, j in enumerate(measured):
@@ -169,9 +167,9 @@ def fit_quality(problem, best):
                                "per_seed": v["per_seed"], "difference": diff, "relative": diff / t["scale"],
                                "contribution": t["weight"] * (diff / t["scale"]) ** 2,
                                "within_seed_scatter": None if v["std"] is None else abs(diff) <= v["std"]})
-    for q in (problem.curve["quantities"] if problem.curve else []):
-        err = np.asarray(best["curves"][q["name"]]["mean"]) - problem.lab[q["name"]]
-        fit["curves"].append({"quantity": q["name"], "rms_error": float(np.sqrt(np.mean(err ** 2))),
+    for q in problem.entries:
+        err = np.asarray(best["curves"][q["label"]]["mean"]) - problem.lab[q["label"]]
+        fit["curves"].append({"quantity": q["label"], "rms_error": float(np.sqrt(np.mean(err ** 2))),
                               "max_abs_error": float(np.max(np.abs(err))), "scale": q["scale"],
                               "relative_rms": float(np.sqrt(np.mean(err ** 2)) / q["scale"]),
                               "contribution": float(q["weight"] * np.mean((err / q["scale"]) ** 2))})
@@ -211,21 +209,24 @@ def plots(folder, problem, history, best):
 
     labels = {"q": ("deviator stress q [kPa]", 1e-3), "sigma1_over_sigma3": ("sigma1/sigma3 [-]", 1.0),
               "eps_v": ("volumetric strain eps_v [%] (contraction +)", 100.0)}
-    if problem.curve:
-        names = problem.quantities()
-        fig, axes = plt.subplots(1, len(names), figsize=(5.5 * len(names), 4.2), squeeze=False)
-        data = problem.curve["data"]
-        for ax, q in zip(axes[0], names):
-            label, f = labels[q]
-            x = 100 * problem.grid
-            ax.plot([100 * e for e in data["eps1"]], [f * v for v in data[q]], "k.-", lw=1, ms=3, label="target (laboratory)")
-            offset = len(problem.targets) + names.index(q) * len(problem.grid)
+    if problem.entries:
+        entries = problem.entry_offsets()
+        fig, axes = plt.subplots(1, len(entries), figsize=(5.5 * len(entries), 4.2), squeeze=False)
+        for ax, (e, offset) in zip(axes[0], entries):
+            label, f = labels[e["name"]]
+            data = e["curve"]["data"]
+            x = 100 * e["grid"]
+            ax.plot([100 * v for v in data["eps1"]], [f * v for v in data[e["name"]]], "k.-", lw=1, ms=3,
+                    label="target (laboratory)")
             for k, y in enumerate(best["per_seed_outputs"]):
                 ax.plot(x, f * y[offset:offset + len(x)], color="tab:red", lw=0.6, alpha=0.5,
                         label="calibrated, each seed" if k == 0 else None)
-            ax.plot(x, f * np.asarray(best["curves"][q]["mean"]), color="tab:red", lw=2, label="calibrated, seed mean")
+            ax.plot(x, f * np.asarray(best["curves"][e["label"]]["mean"]), color="tab:red", lw=2, label="calibrated, seed mean")
             if start["failed"] is None and start is not best:
-                ax.plot(x, f * np.asarray(start["curves"][q]["mean"]), color="grey", ls="--", lw=1.2, label="start point")
+                ax.plot(x, f * np.asarray(start["curves"][e["label"]]["mean"]), color="grey", ls="--", lw=1.2,
+                        label="start point")
+            if e["label"] != e["name"]:
+                ax.set_title(e["label"], fontsize=9)
             ax.set_xlabel("axial strain eps1 [%]")
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
@@ -278,6 +279,10 @@ def report_markdown(inputs, space, problem, history, best, fit, analysis, meta):
              f"Config `{inputs['config']}`, target `{inputs['target_file']}`; seeds {t['seeds']}; optimiser "
              f"{t['optimizer']['algorithm']} (NLopt), budget {t['optimizer']['max_evaluations']} evaluations: "
              f"{sum(e['kind'] == 'optimizer' for e in history)} evaluated, stopped: {meta['stop_reason']}.", "",
+             *([f"Each evaluation runs every seed at {len(problem.conditions)} confining pressures ("
+                + ", ".join(f"{c['confining_pressure'] / 1e3:g} kPa" for c in problem.conditions)
+                + "); a target or curve labelled @P kPa is compared with the runs at that pressure.", ""]
+               if len(problem.conditions) > 1 else []),
              "## Calibrated parameters", "",
              "| parameter | value | seed scatter (1 sigma) | bounds | start | at a bound |", "|---|---|---|---|---|---|"]
     scatter = analysis.get("parameter_seed_scatter", {}) if analysis else {}

@@ -189,23 +189,41 @@ json parseParameters(const toml::table& root, const toml::table& base, const std
   return out;
 }
 
-json parseTargets(const toml::table& root) {
+// The pressure a target or a curve belongs to: its confining_pressure, or the config's. Checked
+// against what the config accepts (parsed with test.confining_pressure = value).
+double parsePressure(Table& t, const toml::table& base, const std::string& baseDir, double configPressure) {
+  const auto p = t.number("confining_pressure", 0.0, 1e10, true, "must be in (0, 1e10] [Pa] (the test's test.confining_pressure)");
+  if (!p) return configPressure;
+  toml::table c = base;
+  io::applyOverride(c, "test.confining_pressure=" + formatValue(*p));
+  try {
+    (void)io::parseConfig(c, baseDir);
+  } catch (const InputError& e) {
+    bad(t.path("confining_pressure"), formatValue(*p), fmt::format("not accepted by the config ({})", e.what()));
+  }
+  return *p;
+}
+
+json parseTargets(const toml::table& root, const toml::table& base, const std::string& baseDir, double configPressure) {
   json out = json::array();
-  std::set<std::string> seen;
+  std::set<std::pair<std::string, double>> seen;
   const auto tables = tableArray(root, "target");
   for (std::size_t i = 0; i < tables.size(); ++i) {
-    Table t(tables[i], fmt::format("target[{}]", i + 1), {"key", "value", "weight", "scale"});
+    Table t(tables[i], fmt::format("target[{}]", i + 1), {"key", "value", "weight", "scale", "confining_pressure"});
     const auto key = t.string("key");
     if (!key || key->empty() || key->find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.") !=
                                     std::string::npos)
       bad(t.path("key"), key.value_or("(missing)"), "a numeric key of summary.json, e.g. \"phi_peak_deg\" (letters, digits, _ and . for nested keys)");
-    if (!seen.insert(*key).second) bad(t.path("key"), *key, "each target key once");
+    const double pressure = parsePressure(t, base, baseDir, configPressure);
+    if (!seen.insert({*key, pressure}).second)
+      bad(t.path("key"), *key, fmt::format("each target key once per confining_pressure (here {} Pa)", formatValue(pressure)));
     const auto value = t.number("value", -1e300, 1e300, false, "a finite number");
     if (!value) bad(t.path("value"), "(missing)", "the measured value is required");
     const double weight = t.number("weight", 0.0, 1e12, true, "must be > 0").value_or(1.0);
     const auto scale = t.number("scale", 0.0, 1e300, true, "must be > 0 (the residual's unit)");
     if (!scale && *value == 0.0) bad(t.path("scale"), "(missing)", "required when value = 0 (default scale: |value|)");
-    out.push_back({{"key", *key}, {"value", *value}, {"weight", weight}, {"scale", scale.value_or(std::abs(*value))}});
+    out.push_back({{"key", *key}, {"summary_key", *key}, {"confining_pressure", pressure}, {"value", *value},
+                   {"weight", weight}, {"scale", scale.value_or(std::abs(*value))}});
   }
   return out;
 }
@@ -267,10 +285,11 @@ std::map<std::string, std::vector<double>> readCurveCsv(const fs::path& file, co
   return columns;
 }
 
-json parseCurve(const toml::table& root, const fs::path& targetDir, double finalAxialStrain) {
-  const toml::table* table = subTable(root, "curve");
-  if (!table) return nullptr;
-  Table t(table, "curve", {"file", "quantities", "q_unit", "strain_unit", "eps1_min", "eps1_max", "points", "weight", "scale"});
+json parseCurve(const toml::table* table, const std::string& name, const fs::path& targetDir, double finalAxialStrain,
+               const toml::table& base, const std::string& baseDir, double configPressure) {
+  Table t(table, name, {"file", "quantities", "q_unit", "strain_unit", "eps1_min", "eps1_max", "points", "weight", "scale",
+                        "confining_pressure"});
+  const double pressure = parsePressure(t, base, baseDir, configPressure);
   const auto file = t.string("file");
   if (!file) bad(t.path("file"), "(missing)", "a CSV file (relative to the target file)");
   const fs::path path = fs::absolute(fs::path(*file).is_absolute() ? fs::path(*file) : targetDir / *file);
@@ -336,10 +355,10 @@ json parseCurve(const toml::table& root, const fs::path& targetDir, double final
                         .value_or(std::min(eps1.back(), finalAxialStrain) / strainFactor) * strainFactor;
   const long points = t.integer("points", 2, 10000).value_or(50);
   if (lo < eps1.front() || hi > eps1.back() || !(hi > lo))
-    bad("curve.eps1_min/eps1_max", fmt::format("[{}, {}]", lo, hi),
+    bad(name + ".eps1_min/eps1_max", fmt::format("[{}, {}]", lo, hi),
         fmt::format("the grid must lie within the file's eps1 range [{}, {}]", eps1.front(), eps1.back()));
   if (hi > finalAxialStrain)
-    bad("curve.eps1_max", formatValue(hi),
+    bad(t.path("eps1_max"), formatValue(hi),
         fmt::format("beyond the run's test.final_axial_strain = {}", formatValue(finalAxialStrain)));
 
   json qs = json::array();
@@ -349,14 +368,77 @@ json parseCurve(const toml::table& root, const fs::path& targetDir, double final
     double scale = 0.0;
     for (double v : columns[q]) scale = std::max(scale, std::abs(q == "sigma1_over_sigma3" ? v - 1.0 : v));
     if (scales.count(q)) scale = scales.at(q);
-    if (!(scale > 0.0)) bad("curve.scale." + q, "(default 0)", "the curve is zero throughout: give curve.scale");
+    if (!(scale > 0.0)) bad(t.path("scale." + q), "(default 0)", "the curve is zero throughout: give " + t.path("scale"));
     qs.push_back({{"name", q}, {"weight", weights.count(q) ? weights.at(q) : 1.0}, {"scale", scale}});
   }
   json data;
   data["eps1"] = eps1;
   for (const auto& q : quantities) data[q] = columns[q];
   return {{"file", path.string()}, {"q_unit", qUnit}, {"strain_unit", strainUnit}, {"quantities", qs},
-          {"eps1_min", lo}, {"eps1_max", hi}, {"points", points}, {"data", data}};
+          {"eps1_min", lo}, {"eps1_max", hi}, {"points", points}, {"data", data}, {"confining_pressure", pressure}};
+}
+
+// [curve] (one table) or [[curve]] (one per confining_pressure).
+json parseCurves(const toml::table& root, const fs::path& targetDir, double finalAxialStrain, const toml::table& base,
+                 const std::string& baseDir, double configPressure) {
+  json out = json::array();
+  const toml::node* n = root.get("curve");
+  if (!n) return out;
+  if (n->is_table()) {
+    out.push_back(parseCurve(n->as_table(), "curve", targetDir, finalAxialStrain, base, baseDir, configPressure));
+    return out;
+  }
+  if (!n->is_array_of_tables())
+    bad("curve", show(*n), "must be a table [curve], or an array of tables [[curve]] (one per confining_pressure)");
+  std::set<double> pressures;
+  std::size_t i = 0;
+  for (const auto& e : *n->as_array()) {
+    const std::string name = fmt::format("curve[{}]", ++i);
+    json c = parseCurve(e.as_table(), name, targetDir, finalAxialStrain, base, baseDir, configPressure);
+    if (!pressures.insert(c["confining_pressure"].get<double>()).second)
+      bad(name + ".confining_pressure", formatValue(c["confining_pressure"].get<double>()),
+          "one curve per confining_pressure (the default is the config's test.confining_pressure)");
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The test conditions the targets and curves need: one run per condition and seed for each
+// evaluation. A file that names no other pressure than the config's has one condition with an
+// empty id (run names and outputs as before there were several); otherwise every pressure is a
+// condition "p<kPa>kPa" whose runs get test.confining_pressure, and every target and curve
+// quantity is labelled with its pressure ("phi_peak_deg@100kPa", "q@100kPa").
+json assignConditions(json& target, double configPressure) {
+  std::set<double> pressures;
+  for (const auto& t : target["targets"]) pressures.insert(t["confining_pressure"].get<double>());
+  for (const auto& c : target["curves"]) pressures.insert(c["confining_pressure"].get<double>());
+  const bool single = pressures.empty() || (pressures.size() == 1 && *pressures.begin() == configPressure);
+  json conditions = json::array();
+  auto idOf = [&](double p) { return single ? std::string() : fmt::format("p{:g}kPa", p / 1e3); };
+  auto suffix = [&](double p) { return single ? std::string() : fmt::format("@{:g}kPa", p / 1e3); };
+  if (single) {
+    conditions.push_back({{"id", ""}, {"confining_pressure", configPressure}, {"sets", json::array()}});
+  } else {
+    std::set<std::string> ids;
+    for (double p : pressures) {
+      if (!ids.insert(idOf(p)).second)
+        bad("confining_pressure", formatValue(p), "pressures must differ in their first 6 digits (in kPa)");
+      conditions.push_back({{"id", idOf(p)}, {"confining_pressure", p},
+                            {"sets", json::array({"test.confining_pressure=" + formatValue(p)})}});
+    }
+  }
+  for (auto& t : target["targets"]) {
+    const double p = t["confining_pressure"].get<double>();
+    t["condition"] = idOf(p);
+    t["key"] = t["summary_key"].get<std::string>() + suffix(p);
+  }
+  for (auto& c : target["curves"]) {
+    const double p = c["confining_pressure"].get<double>();
+    c["condition"] = idOf(p);
+    c["label"] = "curve" + suffix(p);
+    for (auto& q : c["quantities"]) q["label"] = q["name"].get<std::string>() + suffix(p);
+  }
+  return conditions;
 }
 
 json parseSeeds(const toml::table& root, long configSeed) {
@@ -448,15 +530,18 @@ int runCalibrate(const CalibrateOptions& opt) {
                                                  "sensitivity", "execution"};
   for (const auto& [k, v] : root)
     if (std::find(sections.begin(), sections.end(), std::string(k.str())) == sections.end())
-      bad(std::string(k.str()), show(v), "unknown section; allowed: [[parameter]], [[target]], [curve], [evaluation], "
+      bad(std::string(k.str()), show(v), "unknown section; allowed: [[parameter]], [[target]], [curve] or [[curve]], [evaluation], "
                                          "[optimizer], [sensitivity], [execution]");
 
   json target;
   target["parameters"] = parseParameters(root, base, baseDir);
-  target["targets"] = parseTargets(root);
-  target["curve"] = parseCurve(root, fs::absolute(targetPath).parent_path(), config.test.finalAxialStrain);
-  if (target["targets"].empty() && target["curve"].is_null())
+  const double configPressure = config.test.confiningPressure;
+  target["targets"] = parseTargets(root, base, baseDir, configPressure);
+  target["curves"] = parseCurves(root, fs::absolute(targetPath).parent_path(), config.test.finalAxialStrain, base, baseDir,
+                                 configPressure);
+  if (target["targets"].empty() && target["curves"].empty())
     bad("target", "(none)", "give at least one [[target]] (a summary.json value) or a [curve]");
+  target["conditions"] = assignConditions(target, configPressure);
   target["seeds"] = parseSeeds(root, static_cast<long>(config.sample.seed));
   target["optimizer"] = parseOptimizer(root);
   target["sensitivity"] = parseSensitivity(root);

@@ -74,9 +74,9 @@ def test_objective_by_hand(tmp_path):
                 + 0.5 * np.mean((eps_v_error / 4e-3) ** 2))
     assert float(r @ r) == pytest.approx(expected, rel=1e-12)
     # sigma1/sigma3 from the wall stresses: (q + 1e5) / 1e5
-    ratio = curve_problem()
-    ratio.curve["quantities"] = [{"name": "sigma1_over_sigma3", "weight": 1.0, "scale": 1.0}]
-    ratio.lab = {"sigma1_over_sigma3": 1.0 + np.interp(ratio.grid, [0.0, 0.01], [0.0, 2.0])}
+    ratio = Problem({"targets": [], "curve": {"quantities": [{"name": "sigma1_over_sigma3", "weight": 1.0, "scale": 1.0}],
+                                              "eps1_min": 0.0, "eps1_max": 0.01, "points": 11,
+                                              "data": {"eps1": [0.0, 0.01], "sigma1_over_sigma3": [1.0, 3.0]}}})
     _, curves, _ = ratio.outputs(str(tmp_path), {"phi_peak_deg": 38.0})
     assert curves["sigma1_over_sigma3"] == pytest.approx(list(1.0 + 1.1 * 200.0 * grid), rel=1e-12)
 
