@@ -868,15 +868,20 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       s["n_particles"] = sim.particles.size();
       s["e0"] = finite(prep.e0, "e0");
       // With a given prep_friction_deg there is no search and e0 is simply what that friction gives.
-      s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value();
+      // Only compaction searches (growth, lattice, deposition and under-compaction reach their own e0).
+      s["e0_searched"] = config.sample.packing.empty() && !config.sample.prepFrictionDeg.has_value() &&
+                         (config.sample.method == "compaction" || config.sample.method == "loose-moment-free");
       s["e0_within_tolerance"] = std::abs(prep.e0 - config.sample.e0) <= config.sample.e0Tolerance;
       if (!s["e0_within_tolerance"].get<bool>() && !packed.has_value() &&
-          (config.sample.method == "compaction" || config.sample.method == "loose-moment-free")) {
+          (config.sample.method == "compaction" || config.sample.method == "loose-moment-free" ||
+           config.sample.method == "under-compaction")) {
         // A missed e0 target (a given prep_friction_deg is not searched) is reported, never silent.
         const std::string w = fmt::format(
             "e0 = {:.4f} misses sample.e0 = {} by more than sample.e0_tolerance = {}{}", prep.e0, config.sample.e0,
             config.sample.e0Tolerance,
-            config.sample.prepFrictionDeg
+            config.sample.method == "under-compaction"
+                ? std::string(" (under-compaction tamps the layers to e0; consolidation to p then compresses them)")
+            : config.sample.prepFrictionDeg
                 ? fmt::format(" (sample.prep_friction_deg = {} is fixed, not searched)", *config.sample.prepFrictionDeg)
                 : std::string());
         std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
@@ -939,6 +944,41 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
                            {"gravity_work", d.gravityWork},
                            {"steps", d.steps}};
       }
+      if (prep.underCompaction) {
+        const lab::UnderCompactionReport& u = *prep.underCompaction;
+        auto profile = [](const std::vector<double>& e) {
+          json out = json::array();
+          for (double v : e) out.push_back(std::isfinite(v) ? json(v) : json(nullptr));
+          return out;
+        };
+        s["under_compaction"] = {{"layers", u.layers}, {"under_compaction", u.underCompaction},
+                                 {"target_void_ratio", u.targetVoidRatio}, {"width", u.width},
+                                 {"target_heights", u.targetHeights}, {"tamped_void_ratio", u.tampedVoidRatio},
+                                 {"tamper_stress", u.tamperStress}, {"tamper_reached", u.tamperReached}, {"tamper_speed", u.tamperSpeed},
+                                 {"void_ratio", u.voidRatio}, {"Z", u.coordination},
+                                 {"a_r_zz", u.fabricZz ? json(*u.fabricZz) : json(nullptr)},
+                                 {"void_ratio_profile", profile(u.voidRatioProfile)},
+                                 {"prepared_void_ratio_profile", profile(u.preparedProfile)},
+                                 {"gravity_work", u.gravityWork}, {"steps", u.steps}};
+        // A layer a few grains thick is mostly wall: its void ratio is the wall's, not the tamping's.
+        const double layerThickness = u.targetHeights.empty() ? 0.0 : u.targetHeights.back() / u.layers;
+        s["under_compaction"]["layer_thickness_d50"] = layerThickness / prep.grading.d50;
+        if (layerThickness < 3.0 * prep.grading.d50) {
+          const std::string w = fmt::format(
+              "sample.layers = {}: each layer is {:.1f} d50 thick (under 3); more particles or fewer layers",
+              u.layers, layerThickness / prep.grading.d50);
+          std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
+          s["warnings"].push_back(w);
+        }
+        const long stalled = std::count(u.tamperReached.begin(), u.tamperReached.end(), false);
+        if (stalled > 0) {
+          const std::string w = fmt::format(
+              "under-compaction: the tamper stalled at the confining pressure on {} of {} layers (they stay looser "
+              "than their target)", stalled, u.layers);
+          std::fprintf(stderr, "grainlab: warning: %s\n", w.c_str());
+          s["warnings"].push_back(w);
+        }
+      }
       s["dt"] = sim.dt;
       s["dt_critical"] = sim.criticalTimeStep();
       s["preparation_steps"] = prep.steps;
@@ -956,6 +996,9 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
             !config.sample.packing.empty()            ? std::string("from the packing file")
             : config.sample.method == "deposition"    ? fmt::format("deposition at {:.1f} deg: no target",
                                                                         prep.prepFrictionDeg.value_or(0.0))
+            : config.sample.method == "under-compaction"
+                ? fmt::format("{} layers tamped to e {:.3f}, U = {}", config.sample.layers, config.sample.e0,
+                              config.sample.underCompaction)
             : config.sample.method != "compaction"    ? fmt::format("frictionless {}: no target", config.sample.method)
                                                       : fmt::format("target {:.3f}, mu_prep = {:.2f} deg", config.sample.e0,
                                                                     prep.prepFrictionDeg.value_or(0.0));

@@ -195,7 +195,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
       {"sample",
        {"n_particles", "grading", "density", "e0", "seed", "prep_friction_deg", "e0_tolerance", "initial_void_ratio",
         "packing", "prep_stiffness_factor", "prep_ramp_steps", "prep_damping", "method", "growth_rate",
-        "lattice_jitter", "shape", "packing_friction_deg", "drop_height", "gravity"}},
+        "lattice_jitter", "shape", "packing_friction_deg", "drop_height", "gravity", "layers", "under_compaction"}},
       {"contact",
        {"model", "young", "poisson", "friction_deg", "beta", "eta", "wall_friction_deg", "moment_limit", "kn",
         "rolling_friction", "sphericity", "shear_modulus", "rolling", "restitution"}},
@@ -505,7 +505,8 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   static const std::set<std::string> preparation{
       "sample.e0",           "sample.e0_tolerance", "sample.prep_friction_deg", "sample.initial_void_ratio",
       "sample.prep_stiffness_factor", "sample.prep_ramp_steps", "sample.prep_damping", "sample.method",
-      "sample.growth_rate",  "sample.lattice_jitter", "sample.shape", "sample.drop_height"};
+      "sample.growth_rate",  "sample.lattice_jitter", "sample.shape", "sample.drop_height", "sample.layers",
+      "sample.under_compaction"};
   if (packing && (preparation.count(key) || key.rfind("sample.shape.", 0) == 0))
     return "not used with sample.packing (a packing file is taken as it is: no preparation)";
   if (!packing && key == "sample.packing_friction_deg")
@@ -514,7 +515,12 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "{ type = \"packing\" } needs sample.packing";
   if (key == "sample.growth_rate" && method != "growth")
     return "only used with sample.method = \"growth\"; " + here("sample.method", method);
-  if (key == "sample.prep_friction_deg" && method == "deposition") return "";  // the friction of the rain
+  if (key == "sample.prep_friction_deg" && (method == "deposition" || method == "under-compaction"))
+    return "";  // the friction of the rain (and of the tamping)
+  // Under-compaction tamps the layers to the densities of e0: e0 is its target, not searched.
+  if ((key == "sample.e0" || key == "sample.e0_tolerance") && method == "under-compaction") return "";
+  if ((key == "sample.layers" || key == "sample.under_compaction") && method != "under-compaction")
+    return "only used with sample.method = \"under-compaction\"; " + here("sample.method", method);
   if ((key == "sample.e0" || key == "sample.e0_tolerance" || key == "sample.prep_friction_deg") && !searched)
     return "only used with sample.method = \"compaction\" or \"loose-moment-free\" (" +
            (method == "deposition" ? std::string("a deposited sample") : "a frictionless " + method) +
@@ -837,7 +843,13 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                                           "must be in (0, 1] (contact stiffness during compaction as a fraction of contact.young)");
   c.sample.prepRampSteps = s.integer("prep_ramp_steps", c.sample.prepRampSteps, 1, 100'000'000);
   c.sample.prepDamping = s.number("prep_damping", c.sample.prepDamping, 0.0, 1.0, false, true, "must be in [0, 1)");
-  c.sample.method = s.string("method", c.sample.method, {"compaction", "growth", "lattice", "loose-moment-free", "deposition"});
+  c.sample.method = s.string("method", c.sample.method,
+                             {"compaction", "growth", "lattice", "loose-moment-free", "deposition", "under-compaction"});
+  c.sample.layers = static_cast<int>(s.integer("layers", c.sample.layers, 2, 50));
+  c.sample.underCompaction = s.number("under_compaction", c.sample.underCompaction, 0.0, 0.3, false, false,
+                                      "must be in [0, 0.3] (the bottom layer's dry density below that of e0, as a "
+                                      "fraction; 0: every layer tamped to e0)");
+  const bool rained = c.sample.method == "deposition" || c.sample.method == "under-compaction";
   c.sample.dropHeight = s.number("drop_height", c.sample.dropHeight, 0.0, 10.0, false, false,
                                  "must be in [0, 10] [m] (free fall of the lowest grains of the cloud above the floor)");
   if (const toml::node* n = s.raw("gravity")) {
@@ -848,21 +860,22 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     if (norm > 1000.0) fail(key, show(*n), "|g| must be <= 1000 m/s^2 (about 100 times the Earth's)");
     c.sample.gravity = std::array<double, 3>{g[0], g[1], g[2]};
   }
-  if (c.sample.method == "deposition") {
+  if (rained) {
     if (!c.sample.gravity) c.sample.gravity = std::array<double, 3>{0.0, 0.0, -9.81};
     const auto& g = *c.sample.gravity;
     if (!(g[0] == 0.0 && g[1] == 0.0 && g[2] < 0.0))
       fail("sample.gravity", fmt::format("[{}, {}, {}]", g[0], g[1], g[2]),
-           "sample.method = \"deposition\" rains the grains down the z axis onto the floor: allowed [0, 0, -g] with g > 0 "
-           "(default [0, 0, -9.81])");
+           fmt::format("sample.method = \"{}\" rains the grains down the z axis onto the floor: allowed [0, 0, -g] with "
+                       "g > 0 (default [0, 0, -9.81])", c.sample.method));
   }
   c.sample.growthRate = s.number("growth_rate", c.sample.growthRate, 0.0, 0.01, true, false,
                                  "must be in (0, 0.01] (relative radius growth per step)");
   c.sample.latticeJitter = s.number("lattice_jitter", c.sample.latticeJitter, 0.0, 0.05, false, false,
                                     "must be in [0, 0.05] (random lattice site offsets, fraction of the diameter)");
   c.sample.shape = parseShape(s);
-  if (c.sample.method == "deposition" && c.sample.shape.type == "ellipsoid")
-    fail("sample.method", "\"deposition\"", "is for spheres only; allowed with sample.shape.type = \"ellipsoid\": \"compaction\", \"growth\" or \"lattice\"");
+  if (rained && c.sample.shape.type == "ellipsoid")
+    fail("sample.method", "\"" + c.sample.method + "\"",
+         "is for spheres only; allowed with sample.shape.type = \"ellipsoid\": \"compaction\", \"growth\" or \"lattice\"");
   // A packing file brings its own grains: the grading of the run is the packing's.
   if (!c.sample.packing.empty()) c.sample.grading = lab::GradingConfig::ofPacking();
   if (c.sample.latticeJitter > 0.0 && c.sample.method != "lattice")
@@ -961,8 +974,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
   if (c.test.boundary == "periodic" && c.sample.gravity)
     fail("sample.gravity", fmt::format("[{}, {}, {}]", (*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]),
-         c.sample.method == "deposition"
-             ? std::string("sample.method = \"deposition\" needs a floor (grains settle on the box's floor); allowed: test.boundary = \"walls\"")
+         c.sample.method == "deposition" || c.sample.method == "under-compaction"
+             ? fmt::format("sample.method = \"{}\" needs a floor (grains settle on the box's floor); allowed: "
+                           "test.boundary = \"walls\"", c.sample.method)
              : std::string("not with test.boundary = \"periodic\" (a cell has no floor: gravity would accelerate the "
                            "whole sample); allowed: test.boundary = \"walls\""));
   if (lab::info(c.test.type).periodicOnly && c.test.boundary != "periodic")
@@ -1153,6 +1167,8 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(sample, "sample", "growth_rate", c.sample.growthRate);
   put(sample, "sample", "lattice_jitter", c.sample.latticeJitter);
   put(sample, "sample", "drop_height", c.sample.dropHeight);
+  put(sample, "sample", "layers", static_cast<std::int64_t>(c.sample.layers));
+  put(sample, "sample", "under_compaction", c.sample.underCompaction);
   if (c.sample.gravity) put(sample, "sample", "gravity", toml::array{(*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]});
   put(sample, "sample", "shape", shape);
   if (c.sample.packingFrictionDeg) put(sample, "sample", "packing_friction_deg", *c.sample.packingFrictionDeg);

@@ -61,7 +61,7 @@ bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodi
 // Adds the spheres renumbered in cell order (z, y, x) of cells about one large diameter wide, so
 // that neighbours in space are neighbours in memory.
 void addInCellOrder(const std::vector<Vec3>& pos, const std::vector<double>& radii, const Vec3& extent, double density,
-                    Simulation& sim) {
+                    Simulation& sim, bool append = false) {
   const double dMax = 2.0 * radii.front();
   std::array<int, 3> dim{};
   for (int a = 0; a < 3; ++a) dim[a] = SpatialGrid::cellsAlong(extent[a], dMax);
@@ -75,7 +75,7 @@ void addInCellOrder(const std::vector<Vec3>& pos, const std::vector<double>& rad
     return grid.cellIndex(c);
   };
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
-  sim.particles = Particles{};
+  if (!append) sim.particles = Particles{};
   for (std::size_t i : order) sim.particles.addSphere(pos[i], radii[i], density);
 }
 
@@ -122,6 +122,40 @@ ColumnPlacement placeColumn(std::vector<double> diameters, double density, doubl
   out.cloudHeight = height;
   out.cloudSolidFraction = solid / (width * width * height);
   return out;
+}
+
+double appendSlab(std::vector<double> diameters, double density, double voidRatio, double width, double zBottom, Rng& rng,
+                  Simulation& sim) {
+  std::sort(diameters.begin(), diameters.end(), std::greater<>());
+  std::vector<double> radii(diameters.size());
+  double solid = 0.0;
+  for (std::size_t i = 0; i < diameters.size(); ++i) {
+    radii[i] = 0.5 * diameters[i];
+    solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
+  }
+  double height = std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * diameters.front());
+  std::vector<Vec3> pos;
+  while (!tryPlace(radii, Vec3(width, width, height), false, rng, pos)) height *= 1.05;
+  // Cell order within the slab (its own z from the slab's bottom), then lifted onto the bed.
+  addInCellOrder(pos, radii, Vec3(width, width, height), density, sim, true);
+  for (std::size_t i = sim.particles.size() - pos.size(); i < sim.particles.size(); ++i) sim.particles.position[i].z() += zBottom;
+  return height;
+}
+
+double solidVolumeBetween(const Particles& particles, double z0, double z1) {
+  // The volume of a sphere of radius r below the plane at height t above its lowest point
+  // (0 <= t <= 2r) is the cap pi t^2 (3r - t) / 3.
+  auto below = [](double r, double t) {
+    t = std::clamp(t, 0.0, 2.0 * r);
+    return kPi * t * t * (3.0 * r - t) / 3.0;
+  };
+  double v = 0.0;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const double r = particles.radius[i];
+    const double bottom = particles.position[i].z() - r;
+    v += below(r, z1 - bottom) - below(r, z0 - bottom);
+  }
+  return v;
 }
 
 void placeLattice(int n, double d, double density, Simulation& sim) {

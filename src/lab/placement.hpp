@@ -27,6 +27,18 @@ struct ColumnPlacement {
 ColumnPlacement placeColumn(std::vector<double> diameters, double density, double voidRatio, double bedVoidRatio,
                             double dropHeight, Rng& rng, Simulation& sim);
 
+// sample.method = "under-compaction": appends spheres, placed at random without overlaps, in the
+// slab [0, width]^2 x [zBottom, zBottom + h] of a wall box, h such that the slab's cloud has the
+// given void ratio (grown by 5 % if a sphere finds no room), in cell order after the particles
+// already there (new ids follow theirs). zBottom at or above every grain already there: the slab
+// overlaps none of them. Returns h. The box is left as it is.
+double appendSlab(std::vector<double> diameters, double density, double voidRatio, double width, double zBottom, Rng& rng,
+                  Simulation& sim);
+
+// The solid volume of spheres between the horizontal planes z0 < z1 (spherical caps): the void
+// ratio profile of a layered sample. Spheres only.
+double solidVolumeBetween(const Particles& particles, double z0, double z1);
+
 // [O] §5.1: n^3 equal spheres of diameter d on a simple cubic lattice of spacing d (just touching),
 // filling the cube of side n d: the cell (periodic) or the box of walls.
 void placeLattice(int n, double d, double density, Simulation& sim);

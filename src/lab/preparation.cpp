@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.hpp"
 #include "lab/measurements.hpp"
@@ -26,6 +27,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   setFriction(muDeg);
   if (config_.sample.method == "growth") steps += growRadii();
   if (config_.sample.method == "deposition") steps += deposit();
+  if (config_.sample.method == "under-compaction") steps += underCompact();
   // "loose-moment-free": no contact moments while the skeleton forms (Kozicki–Donze: no rolling
   // stiffness; rolling-linear: no rolling friction); configureSolver() below and the saved rolling
   // friction switch them on again, from zero moment, before the full-stiffness equilibrium.
@@ -39,6 +41,7 @@ double Laboratory::compactWithFriction(const Simulation& loose, double muDeg, Si
   steps += consolidate(config_.test.confiningPressure,
                        searched ? fmt::format("compaction (mu_prep {:.1f} deg{})", muDeg, momentFree ? ", no moments" : "")
                        : config_.sample.method == "deposition" ? std::string("consolidation of the deposited bed")
+                       : config_.sample.method == "under-compaction" ? std::string("consolidation of the tamped layers")
                                                                : std::string("isotropic compression"));
   // A lattice keeps its perfect symmetry through any loading (it deforms affinely); [O]'s growth
   // from the compressed lattice is not affine. sample.lattice_jitter moves every grain of the
@@ -90,8 +93,9 @@ PreparationResult Laboratory::prepare() {
     return e;
   };
 
-  if (config_.sample.method == "deposition") {
-    // The grains rain and settle at sample.prep_friction_deg when given, else at the contact friction.
+  if (config_.sample.method == "deposition" || config_.sample.method == "under-compaction") {
+    // The grains rain and settle (and are tamped) at sample.prep_friction_deg when given, else at
+    // the contact friction.
     trial(config_.sample.prepFrictionDeg.value_or(config_.contact.frictionDeg));
   } else if (config_.sample.method != "compaction" && config_.sample.method != "loose-moment-free") {
     trial(0.0);  // frictionless growth or lattice: the e0 reached is the result, not a target
@@ -140,6 +144,10 @@ PreparationResult Laboratory::prepare() {
   sim_ = std::move(best);
   result.growth = growthCurve_;
   result.deposition = deposition_;
+  if (underCompaction_) {
+    result.underCompaction = underCompaction_;
+    result.underCompaction->preparedProfile = voidRatioProfile(underCompaction_->layers);
+  }
   records_.reset(sim_);
   result.state = equilibriumState();
   result.coordination = coordination(microNetwork(sim_));
@@ -161,6 +169,27 @@ void Laboratory::placeSample(PreparationResult& result) {
     deposition_->cloudHeight = column.cloudHeight;
     deposition_->cloudSolidFraction = column.cloudSolidFraction;
     deposition_->width = column.width;
+  } else if (config_.sample.method == "under-compaction") {
+    // The footprint: the sample at its target e0 is a cube. The grains are dealt at random into
+    // `layers` equal shares (each a sample of the grading), the first placed now as a cloud on the
+    // floor, the others above the bed as they come (underCompact).
+    std::vector<double> order = diameters;
+    for (std::size_t i = order.size(); i > 1; --i)
+      std::swap(order[i - 1], order[std::min(i - 1, static_cast<std::size_t>(rng.uniform() * static_cast<double>(i)))]);
+    const int layers = config_.sample.layers;
+    layerDiameters_.assign(layers, {});
+    for (std::size_t i = 0; i < order.size(); ++i) layerDiameters_[i * layers / order.size()].push_back(order[i]);
+    double solid = 0.0;
+    for (double d : diameters) solid += kPi / 6.0 * d * d * d;
+    const double width = std::max(std::cbrt(solid * (1.0 + config_.sample.e0)), 2.0 * *std::max_element(diameters.begin(), diameters.end()));
+    sim_.particles = Particles{};
+    const double h = appendSlab(layerDiameters_[0], config_.sample.density, config_.sample.initialVoidRatio, width, 0.0, rng, sim_);
+    sim_.box.setBounds(Vec3::Zero(), Vec3(width, width, h));
+    underCompaction_ = UnderCompactionReport{};
+    underCompaction_->layers = layers;
+    underCompaction_->underCompaction = config_.sample.underCompaction;
+    underCompaction_->targetVoidRatio = config_.sample.e0;
+    underCompaction_->width = width;
   } else if (config_.sample.method == "lattice") {
     // Equal spheres of the grading's d50 ([O]'s N = n^3 equal grains).
     const int n = static_cast<int>(std::lround(std::cbrt(static_cast<double>(config_.sample.nParticles))));
@@ -186,12 +215,8 @@ void Laboratory::placeSample(PreparationResult& result) {
   }
 }
 
-long Laboratory::deposit() {
-  // Every wall still: the grains fall from rest and settle on the floor.
-  for (int a = 0; a < 3; ++a) boundary_->fix(a);
+long Laboratory::settle(const std::string& phase, double work0) {
   const double unbTol = config_.solver.unbalancedTolerance;
-  const double work0 = sim_.energy.gravityWork;
-  const std::string phase = "deposition (rain and settling)";
   Pipeline pipeline(sim_);
   pipeline.addAfter("settling check", [&] {
     const long steps = pipeline.steps();
@@ -214,6 +239,14 @@ long Laboratory::deposit() {
   }, Pipeline::Trigger::period(100));
   const long steps = pipeline.run();
   if (progress_) progress_(phase, 1.0, steps);
+  return steps;
+}
+
+long Laboratory::deposit() {
+  // Every wall still: the grains fall from rest and settle on the floor.
+  for (int a = 0; a < 3; ++a) boundary_->fix(a);
+  const double work0 = sim_.energy.gravityWork;
+  const long steps = settle("deposition (rain and settling)", work0);
   // The top platen comes down onto the bed's highest grain.
   const Particles& P = sim_.particles;
   double top = sim_.box.lower(2).position;
@@ -227,6 +260,111 @@ long Laboratory::deposit() {
   if (bed.ar) deposition_->settledFabricZz = bed.ar->tensor(2, 2);
   deposition_->gravityWork = sim_.energy.gravityWork - work0;
   deposition_->steps = steps;
+  return steps;
+}
+
+namespace {
+
+double bedTop(const Simulation& sim) {
+  const Particles& P = sim.particles;
+  double top = sim.box.lower(2).position;
+  for (std::size_t i = 0; i < P.size(); ++i) top = std::max(top, P.position[i].z() + P.radius[i]);
+  return top;
+}
+
+double solidVolume(const std::vector<double>& diameters) {
+  double v = 0.0;
+  for (double d : diameters) v += kPi / 6.0 * d * d * d;
+  return v;
+}
+
+}  // namespace
+
+std::vector<double> Laboratory::voidRatioProfile(int slices) const {
+  const double z0 = sim_.box.lower(2).position, z1 = sim_.box.upper(2).position;
+  const double area = sim_.box.length(0) * sim_.box.length(1);
+  const double dz = (z1 - z0) / slices;
+  std::vector<double> e(slices);
+  for (int k = 0; k < slices; ++k) {
+    const double solid = solidVolumeBetween(sim_.particles, z0 + k * dz, z0 + (k + 1) * dz);
+    e[k] = solid > 0.0 ? area * dz / solid - 1.0 : std::numeric_limits<double>::infinity();
+  }
+  return e;
+}
+
+long Laboratory::underCompact() {
+  UnderCompactionReport& r = *underCompaction_;
+  const int layers = r.layers;
+  const double area = r.width * r.width;
+  const double floor = sim_.box.lower(2).position;
+  const double work0 = sim_.energy.gravityWork;
+  // The clouds of layers 2..L: a stream of their own (the first layer's came from placeSample's).
+  Rng rng(config_.sample.seed ^ 0x2545f4914f6cdd1dull);
+  Wall& platen = sim_.box.upper(2);
+  double target = floor;
+  double below = floor;  // the top of the layers below at the target density
+  double solidSoFar = 0.0;
+  long steps = 0;
+  for (int k = 0; k < layers; ++k) {
+    const double solid = solidVolume(layerDiameters_[k]);
+    solidSoFar += solid;
+    // Ladd (1978): layer k (0 = the bottom) is tamped to a dry density (1 - U_k) times the
+    // target's, U_k falling linearly from U at the bottom to 0 at the top, on the layers below
+    // taken at the target density: tamping layer k compacts the layers below it further, which
+    // their under-compaction anticipates. The last layer (U = 0) ends the stack at e0.
+    const double u = r.underCompaction * static_cast<double>(layers - 1 - k) / static_cast<double>(layers - 1);
+    target = below + solid * (1.0 + r.targetVoidRatio) / (1.0 - u) / area;
+    below += solid * (1.0 + r.targetVoidRatio) / area;
+    if (k > 0) {
+      // The platen is lifted and the next cloud placed above the bed.
+      const double top = bedTop(sim_);
+      const double h = appendSlab(layerDiameters_[k], config_.sample.density, config_.sample.initialVoidRatio, r.width, top,
+                                  rng, sim_);
+      platen.position = top + h;
+      sim_.initialise(config_.solver.skinFraction);
+      sim_.dt = config_.solver.dtFactor * sim_.criticalTimeStep();
+    }
+    for (int a = 0; a < 3; ++a) boundary_->fix(a);
+    const double travel = platen.position - target;
+    if (travel > 0.0) {
+      // The tamper: the top platen at a constant speed, kTampSteps steps from the cloud's top to
+      // the target height, where it stops.
+      r.tamperSpeed = travel / (static_cast<double>(kTampSteps) * sim_.dt);
+      platen.control = WallControl::Velocity;
+      platen.velocity = -r.tamperSpeed;
+      Pipeline pipeline(sim_);
+      // The tamping effort is capped at the confining pressure p: a layer the platen cannot bring to
+      // its height without pushing harder than p stays looser (reported), instead of being
+      // over-consolidated by a stress the test never applies (and springing back from it).
+      const double cap = config_.test.confiningPressure;
+      const int topFace = WallBox::index(2, 1);
+      pipeline.addAfter("tamper", [&] {
+        if (platen.position <= target || sim_.box.wallStress(topFace) > cap) {
+          platen.control = WallControl::Fixed;
+          platen.velocity = 0.0;
+          pipeline.stop();
+        }
+      }, Pipeline::Trigger::period(1));
+      steps += pipeline.run();
+    }
+    r.tamperStress.push_back(sim_.box.wallStress(WallBox::index(2, 1)));
+    r.tamperReached.push_back(platen.position <= target);
+    steps += settle(fmt::format("under-compaction: layer {}/{} tamped, settling", k + 1, layers), work0);
+    r.targetHeights.push_back(target - floor);
+    r.tampedVoidRatio.push_back(area * (bedTop(sim_) - floor) / solidSoFar - 1.0);
+  }
+  // The grains of every layer in place: rolling friction per grain for all of them (the first
+  // assignment saw the first layer only), and the platen down onto the bed's highest grain.
+  records_.sphericity = assignRollingFriction(config_, sim_.particles);
+  platen.position = bedTop(sim_);
+  sim_.initialise(config_.solver.skinFraction);
+  r.voidRatio = voidRatio(sim_);
+  r.coordination = coordinationNumber(sim_);
+  const MicroAnalysis bed = micro_.analyse(microNetwork(sim_));
+  if (bed.ar) r.fabricZz = bed.ar->tensor(2, 2);
+  r.voidRatioProfile = voidRatioProfile(layers);
+  r.gravityWork = sim_.energy.gravityWork - work0;
+  r.steps = steps;
   return steps;
 }
 

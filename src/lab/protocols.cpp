@@ -80,7 +80,9 @@ Laboratory::Laboratory(const Laboratory& o)
       microColumns_(o.microColumns_),
       d50_(o.d50_),
       growthCurve_(o.growthCurve_),
-      deposition_(o.deposition_) {
+      deposition_(o.deposition_),
+      layerDiameters_(o.layerDiameters_),
+      underCompaction_(o.underCompaction_) {
   boundary_ = BoundaryControl::of(sim_);
   boundary_->restoreReference(o.boundary_->referenceLengths(), o.boundary_->referenceVolume());
   if (o.protocol_) {

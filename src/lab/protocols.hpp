@@ -112,6 +112,30 @@ struct DepositionReport {
   long steps = 0;
 };
 
+// sample.method = "under-compaction": the layers and their tamping, before the platen and the servos
+// take over.
+struct UnderCompactionReport {
+  int layers = 0;
+  double underCompaction = 0.0;       // U of the bottom layer
+  double targetVoidRatio = 0.0;       // e0: the density every layer is meant to end at
+  double width = 0.0;                 // [m] side of the square footprint
+  std::vector<double> targetHeights;  // [m] platen height after tamping layer k (the sample built so far)
+  std::vector<double> tampedVoidRatio;  // e of the sample built so far, after tamping layer k and relaxing
+  std::vector<double> tamperStress;   // [Pa] the platen's stress when it stopped, per layer
+  std::vector<bool> tamperReached;    // per layer: the platen reached its height (false: it stalled at p)
+  double tamperSpeed = 0.0;           // [m/s] of the last layer
+  // After the last layer (before consolidation): e, Z, a_r_zz, and e of `layers` horizontal slices of
+  // equal thickness from the floor to the platen (the void ratio profile).
+  double voidRatio = 0.0;
+  double coordination = 0.0;
+  std::optional<double> fabricZz;
+  std::vector<double> voidRatioProfile;
+  // The same profile after consolidation to p and the final equilibrium (what the test starts from).
+  std::vector<double> preparedProfile;
+  double gravityWork = 0.0;  // [J]
+  long steps = 0;
+};
+
 struct PreparationResult {
   double e0 = 0.0;                          // reached
   std::vector<GrowthStage> growth;          // the shape growth curve (ellipsoids), stage 0 = spheres
@@ -124,6 +148,7 @@ struct PreparationResult {
   // over the non-rattlers (null when every grain is a rattler).
   Coordination coordination{};
   std::optional<DepositionReport> deposition;  // sample.method = "deposition"
+  std::optional<UnderCompactionReport> underCompaction;  // sample.method = "under-compaction"
 };
 
 struct ShearResult {
@@ -277,6 +302,16 @@ class Laboratory {
   long deposit();
   static constexpr double kSettledKineticFraction = 1e-3;
   std::optional<DepositionReport> deposition_;  // of the last deposit(); preparation only
+  // sample.method = "under-compaction": each layer placed as a cloud above the bed (the first by
+  // placeSample), rained and tamped by the top platen at a constant speed (kTampSteps steps from the
+  // cloud's top to the layer's target height), held there until at rest, the platen lifted for the
+  // next. Fills underCompaction_.
+  long underCompact();
+  long settle(const std::string& phase, double work0);  // walls as they are, until at rest under gravity
+  static constexpr long kTampSteps = 100000;
+  std::vector<std::vector<double>> layerDiameters_;  // the grains of each layer (placeSample)
+  std::optional<UnderCompactionReport> underCompaction_;
+  std::vector<double> voidRatioProfile(int slices) const;
   // Frictionless growth of the grains chosen to be ellipsoids from their equal-volume spheres to
   // sample.shape, in steps of eccentricity with the boundary holding p after each ([O] §5.2-5.3).
   long growShapes();

@@ -92,8 +92,16 @@ struct SampleConfig {
   // side walls take over and consolidate to the confining pressure (docs/lab.md, preparation).
   // drop_height [m]: free fall of the cloud's lowest grains above the floor.
   double dropHeight = 0.0;
-  // Gravity [m/s^2], every protocol (walls only): none unless given; "deposition" defaults to
-  // (0, 0, -9.81) and needs it along -z.
+  // "under-compaction" (Ladd 1978's moist tamping, layer by layer; docs/laboratory.md §1.8): the
+  // grains in `layers` equal shares, each rained as a cloud onto the bed under gravity and tamped by
+  // the top platen to a height at which the sample built so far has its layers' target densities:
+  // layer j (1 = the bottom) at a dry density (1 - U_j) times that of e0, U_j = under_compaction
+  // (L - j)/(L - 1), so that the lower layers, compacted again by every tamping above them, end up
+  // as dense as the upper ones. Then the platen and the side walls take over, as after deposition.
+  int layers = 5;
+  double underCompaction = 0.05;
+  // Gravity [m/s^2], every protocol (walls only): none unless given; "deposition" and
+  // "under-compaction" default to (0, 0, -9.81) and need it along -z.
   std::optional<std::array<double, 3>> gravity;
   ShapeConfig shape;
 };

@@ -223,6 +223,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "G_MPa", "final_shear_strain",         # simple shear
     "growth_curve",                        # ellipsoid shape growth
     "deposition",                          # sample.method = "deposition"
+    "under_compaction",                    # sample.method = "under-compaction"
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
     # undrained tests

@@ -86,7 +86,8 @@ static_assert(sizeof(lab::Laboratory) ==
                              std::unique_ptr<lab::ShearProtocol>, std::unique_ptr<lab::BoundaryControl>,
                              ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
                              lab::MicroColumnSet, double, std::vector<lab::GrowthStage>,
-                             std::optional<lab::DepositionReport>>(),
+                             std::optional<lab::DepositionReport>, std::vector<std::vector<double>>,
+                             std::optional<lab::UnderCompactionReport>>(),
               "Laboratory changed: update Laboratory::saveState/loadState and this list");
 static_assert(std::is_trivially_copyable_v<Wall> && std::is_trivially_copyable_v<lab::Record> &&
               std::is_trivially_copyable_v<contact::SphereContactModel>);
