@@ -2,7 +2,7 @@
 """Plots of one grainlab results folder: q-eps1, eps_v-eps1, phi-eps1, e-eps1, energy (PNG in DIR/plots).
 
 Usage: plot_run.py DIR
-Reads DIR/timeseries.csv (and DIR/summary.json for the annotations). Signs as in PHYSICS.md §0:
+Reads DIR/timeseries.csv (and DIR/summary.json for the annotations). Signs as in docs/physics.md §1:
 compression positive, eps_v > 0 in contraction (dilation plots downward)."""
 import csv
 import json

@@ -38,7 +38,7 @@ namespace {
 
 // The optimisers of NLopt offered (tools/calibrate.py maps them; docs/calibration.md says why).
 const std::vector<std::string> kAlgorithms{"bobyqa", "cobyla", "neldermead", "sbplx", "direct", "crs2"};
-// Curve columns a laboratory file may give besides eps1 (PHYSICS.md §0 signs: eps_v > 0 in contraction).
+// Curve columns a laboratory file may give besides eps1 (docs/physics.md §1 signs: eps_v > 0 in contraction).
 const std::vector<std::string> kCurveQuantities{"q", "sigma1_over_sigma3", "eps_v"};
 constexpr std::uintmax_t kMaxCurveBytes = 16u << 20;
 constexpr std::size_t kMaxCurveRows = 100000;

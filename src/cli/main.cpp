@@ -1,4 +1,4 @@
-// The grainlab command line (INTERFACE.md). Exit codes: 0 success, 2 bad input, 1 failed run.
+// The grainlab command line (docs/interface.md). Exit codes: 0 success, 2 bad input, 1 failed run.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>

@@ -41,7 +41,7 @@ struct EllipsoidHistory : ContactHistory {
 };
 
 // What the law returns: force of A on B, and the contact moment accumulated from the rotation of
-// B relative to A (B receives -moment, A receives +moment; PHYSICS.md §3.1).
+// B relative to A (B receives -moment, A receives +moment; docs/physics.md §4.1).
 struct ContactResponse {
   Vec3 force;
   Vec3 normalForce;
@@ -85,10 +85,10 @@ inline double combineRollingFriction(CombineRule rule, double a, double b) {
 // Which rolling slot a sphere model uses. One enum for the whole run: the branch in pairParams is
 // the same for every contact (perfectly predicted), no per-contact dispatch through pointers.
 enum class RollingLaw {
-  // Kozicki–Donzé ([W] §3, PHYSICS.md §3.1): Kr = beta Ks RA RB, full relative rotation (bending
+  // Kozicki–Donzé ([W] §3, docs/physics.md §4.1): Kr = beta Ks RA RB, full relative rotation (bending
   // and twisting), |M| <= eta (RA+RB)/2 |Fn|.
   KozickiDonze,
-  // Linear rolling resistance ([R], PHYSICS.md §3.2): R = RA RB/(RA+RB), kr = Ks R^2, bending
+  // Linear rolling resistance ([R], docs/physics.md §4.2): R = RA RB/(RA+RB), kr = Ks R^2, bending
   // only, |Mr| <= mu_r |Fn| R with mu_r combined from the two grains' values.
   Linear,
   // No contact moment (Hertz–Mindlin without a rolling slot).

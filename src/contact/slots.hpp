@@ -1,6 +1,6 @@
 #pragma once
 // Contact-law slots (normal, tangential, rolling/twisting) as pure kernels over small structs
-// (PHYSICS.md §3). They know nothing of particle or contact storage; presets in models.hpp
+// (docs/physics.md §4). They know nothing of particle or contact storage; presets in models.hpp
 // compose them. Convention: forces and moments are those of A on B; N points from A to B.
 #include <cmath>
 
@@ -55,7 +55,7 @@ struct SlipResult {
   bool sliding;
 };
 
-// Tangential slot: incremental elastic spring with Coulomb limit (PHYSICS.md §3.1).
+// Tangential slot: incremental elastic spring with Coulomb limit (docs/physics.md §4.1).
 // `carriedShear` is the previous Fs already carried into the current contact frame, `dXs` the
 // tangential displacement increment of B relative to A. Any normal component left by round-off is
 // removed so Fs stays in the tangent plane.

@@ -164,7 +164,7 @@ void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& c
         "more particles (at least ~3 largest diameters per side)", widths.minCoeff(), range));
   // Grid in scaled coordinates: n_k cells along axis k, each at least `range` wide in real space
   // (the distance between the cell's faces is widths_k / n_k), so everything within range of a
-  // point is in the 3x3x3 block around its cell (PHYSICS.md §5.2).
+  // point is in the 3x3x3 block around its cell (docs/physics.md §8.2).
   const SpatialGrid::Cell dims = SpatialGrid::dimsFor({widths[0], widths[1], widths[2]}, range, std::max<std::size_t>(27, 4 * n));
   std::vector<SpatialGrid::Cell> cellOf(n);
   grid_.reset(dims);

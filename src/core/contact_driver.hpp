@@ -58,7 +58,7 @@ GRAINLAB_ALWAYS_INLINE contact::ContactKinematics pairKinematics(const ContactCo
   k.overlap = g.overlap;
   k.relativeVelocity = (v[b] + w[b].cross(g.branchB)) - (v[a] + w[a].cross(g.branchA));
   // In a periodic cell the bodies' velocities are fluctuations about the homogeneous flow, whose
-  // relative velocity across the branch (image shift included) is L l (PHYSICS.md §2, §5.2).
+  // relative velocity across the branch (image shift included) is L l (docs/physics.md §3, §8.2).
   if constexpr (Periodic) k.relativeVelocity += ctx.cell.velocityGradient * branch;
   k.relativeSpin = w[b] - w[a];
   k.meanSpinNormal = 0.5 * (w[a] + w[b]).dot(g.normal);

@@ -1,5 +1,5 @@
 #pragma once
-// The periodic cell ([O] §3.4.6–3.4.8, PHYSICS.md §5.2): a parallelepiped whose edge vectors are the
+// The periodic cell ([O] §3.4.6–3.4.8, docs/physics.md §8.2): a parallelepiped whose edge vectors are the
 // columns of H, deformed by a homogeneous velocity gradient L (dH/dt = L H). A particle leaving
 // through a face re-enters through the opposite one; a contact with a periodic image carries the
 // integer image shift s of its second body, whose image sits at x_B + H s.
@@ -68,7 +68,7 @@ struct PeriodicCell {
   // When set, L is whatever the caller put in velocityGradient (a scripted deformation): no servo,
   // no imposed rates, the cell only follows L.
   bool prescribedGradient = false;
-  // Measured every step by the contact stage (Love–Weber over the contacts, PHYSICS.md §7.1) and
+  // Measured every step by the contact stage (Love–Weber over the contacts, docs/physics.md §9) and
   // the affine stiffness of the assembly for the servo: K_k = (1/V) sum |l|^2 n_k^2 (kn n_k^2 +
   // ks (1 - n_k^2)), the stress change per unit compressive strain of axis k if every contact
   // deformed with the mean strain.

@@ -1,5 +1,5 @@
 #pragma once
-// Rotation of a rigid body with distinct principal moments (PHYSICS.md §4; docs/ellipsoids.md):
+// Rotation of a rigid body with distinct principal moments (docs/physics.md §6; docs/ellipsoids.md):
 // pure kernels for the engine's leapfrog, which keeps the orientation q^n at full steps and the
 // world-frame angular velocity w^(n-1/2) at mid-steps.
 //
@@ -124,7 +124,7 @@ inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMoment
   return out;
 }
 
-// Cundall local damping of a torque (PHYSICS.md §4), per world component against the sign of the
+// Cundall local damping of a torque (docs/physics.md §5), per world component against the sign of the
 // mid-step angular velocity; returns the damping torque to add (0 where w_k = 0).
 inline Vec3 localDampingTorque(const Vec3& torque, const Vec3& omegaMid, double alpha) {
   Vec3 td;

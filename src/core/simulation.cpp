@@ -355,7 +355,7 @@ void Simulation::controlCell() {
 }
 
 void Simulation::setCellGradient() {
-  // The cell's stress servo (PHYSICS.md §5.2), the strain-space twin of the wall servo
+  // The cell's stress servo (docs/physics.md §8.2), the strain-space twin of the wall servo
   // (servo_settings.hpp): the stress error over the assembly's affine stiffness K is the
   // compressive strain u that would cancel it if every contact deformed with the mean strain; the
   // cell strains by gain u per step plus an integral term that learns the rate a dilating or
@@ -487,7 +487,7 @@ void Simulation::integrateFor() {
         w[i] += (t + td) * (h * particles.invInertia[i]);
       }
       if (w[i].squaredNorm() > 0.0) {
-        // q <- exp(w dt / 2) q with the exponential to first order, renormalised (PHYSICS.md §4).
+        // q <- exp(w dt / 2) q with the exponential to first order, renormalised (docs/physics.md §6).
         const Vec3 half = 0.5 * h * w[i];
         Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
         // |qn|^2 = 1 + eps with eps ~ |w dt|^2 / 4 (~1e-10): 1/sqrt(1 + eps) by its series

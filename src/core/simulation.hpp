@@ -27,7 +27,7 @@
 
 namespace grainlab {
 
-// Cumulative energy terms tracked by the engine [J] (PHYSICS.md §7.6, partial).
+// Cumulative energy terms tracked by the engine [J] (docs/physics.md §10, partial).
 struct EnergyLedger {
   double slip = 0.0;
   double rolling = 0.0;
@@ -66,7 +66,7 @@ class Simulation {
   Vec3 gravity = Vec3::Zero();  // [m/s^2]; off in the triaxial tests of [W]
   double dt = 0.0;            // [s]
   double localDamping = 0.3;  // Cundall alpha [-]
-  // [O]'s viscous mass- and inertia-proportional damping alpha [1/s] (PHYSICS.md §4), integrated by
+  // [O]'s viscous mass- and inertia-proportional damping alpha [1/s] (docs/physics.md §5), integrated by
   // the midpoint rule; when > 0 it replaces the local damping.
   double viscousDamping = 0.0;
   long stepCount = 0;
@@ -75,7 +75,7 @@ class Simulation {
   // Sets the neighbour skin from the particle sizes; call after adding particles or changing the
   // boundary.
   void initialise(double skinFraction = 0.2);
-  // Critical time step (PHYSICS.md §4): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
+  // Critical time step (docs/physics.md §7): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
   // the stiffest contact the particle can have (against a wall).
   double criticalTimeStep() const;
   // One step: every engine stage in order, inside one OpenMP parallel region (one fork/join per

@@ -1,5 +1,5 @@
 #pragma once
-// A box of six rigid planar walls (PHYSICS.md §5.1). Wall k = 2*axis + side (side 0: lower, 1: upper).
+// A box of six rigid planar walls (docs/physics.md §8.1). Wall k = 2*axis + side (side 0: lower, 1: upper).
 #include <array>
 
 #include "core/types.hpp"

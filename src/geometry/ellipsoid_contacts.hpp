@@ -1,5 +1,5 @@
 #pragma once
-// Narrow phase for ellipsoids (PHYSICS.md §6; derivations in docs/ellipsoids.md): pure functions,
+// Narrow phase for ellipsoids (docs/physics.md §3; derivations in docs/ellipsoids.md): pure functions,
 // no storage. Contacts between ellipsoids (and a sphere and an ellipsoid) come from the
 // Perram–Wertheim contact function [PW85]
 //     F(A, B) = max over lambda in [0, 1] of S(lambda),

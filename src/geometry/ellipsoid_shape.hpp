@@ -1,5 +1,5 @@
 #pragma once
-// Triaxial ellipsoid shape (PHYSICS.md §1, [O] ch. 3): semi-axes a >= b >= c along the body x, y,
+// Triaxial ellipsoid shape (docs/physics.md §2, [O] ch. 3): semi-axes a >= b >= c along the body x, y,
 // z axes, [O]'s shape parameters, mass and principal inertia, and the shape matrix
 // X = Q diag(a^2, b^2, c^2) Q^T that every ellipsoid contact kernel works with. Pure functions.
 #include <cmath>
@@ -54,7 +54,7 @@ inline double equivalentRadius(const Vec3& s) { return std::cbrt(s.x() * s.y() *
 inline double elongationRatio(const Vec3& s) { return s.y() / s.x(); }  // elr = b/a <= 1
 inline double flatnessRatio(const Vec3& s) { return s.z() / s.y(); }    // flr = c/b <= 1
 // [O]'s eccentricity (a - b)/(a + b) = (1 - elr)/(1 + elr): 0.176 for elr = 0.7, 0.111 for 0.8.
-// For prolate spheroids (b = c) it is PHYSICS.md §1's (a - c)/(a + c).
+// For prolate spheroids (b = c) it is docs/physics.md §2's (a - c)/(a + c).
 inline double eccentricity(const Vec3& s) { return (s.x() - s.y()) / (s.x() + s.y()); }
 
 inline double ellipsoidVolume(const Vec3& s) { return 4.0 / 3.0 * kPi * s.x() * s.y() * s.z(); }

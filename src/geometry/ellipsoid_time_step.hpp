@@ -1,5 +1,5 @@
 #pragma once
-// Critical time step of an ellipsoid held by its stiffest contact (PHYSICS.md §4), including the
+// Critical time step of an ellipsoid held by its stiffest contact (docs/physics.md §7), including the
 // rotational stiffness that elongation adds (docs/ellipsoids.md, "Critical time step").
 #include <algorithm>
 #include <cmath>

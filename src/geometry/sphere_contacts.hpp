@@ -1,5 +1,5 @@
 #pragma once
-// Narrow phase for spheres (PHYSICS.md §2): pure functions, no storage.
+// Narrow phase for spheres (docs/physics.md §3): pure functions, no storage.
 #include <cmath>
 
 #include "core/types.hpp"

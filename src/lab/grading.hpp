@@ -1,5 +1,5 @@
 #pragma once
-// Particle size distributions (LAB.md test 1): a sieve curve (percent passing by mass), a range
+// Particle size distributions (docs/laboratory.md §1): a sieve curve (percent passing by mass), a range
 // uniform by number, or a list of diameters.
 #include <string>
 #include <vector>

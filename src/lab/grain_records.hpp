@@ -1,5 +1,5 @@
 #pragma once
-// The laboratory's record of every grain (PHYSICS.md §7.4), kept beside the engine's particle
+// The laboratory's record of every grain (docs/laboratory.md §3.3), kept beside the engine's particle
 // arrays, not in them: reference position and orientation (the state at the start of shearing),
 // the path integral of |omega| dt since then, and the sphericity a grain was given ([R]). Indexed like
 // the particles; Laboratory keeps the two in step.

@@ -1,5 +1,5 @@
 #pragma once
-// Grain kinematics since a reference state (PHYSICS.md §7.4): displacement, rotation, local strain
+// Grain kinematics since a reference state (docs/laboratory.md §3.3): displacement, rotation, local strain
 // and the shear band.
 //
 // Local strain: for each grain, the displacement gradient G that best maps the reference

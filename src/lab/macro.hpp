@@ -1,5 +1,5 @@
 #pragma once
-// Macro-parameters of a drained triaxial test from its recorded curves (PHYSICS.md §7.3).
+// Macro-parameters of a drained triaxial test from its recorded curves (docs/laboratory.md §4).
 // Pure functions of the curves, so they can be tested on synthetic data with known answers.
 #include <optional>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// What is measured on an assembly, in a wall box or a periodic cell (PHYSICS.md §7.1, §7.2, §7.5
+// What is measured on an assembly, in a wall box or a periodic cell (docs/physics.md §9, §11
 // in part).
 #include "core/simulation.hpp"
 

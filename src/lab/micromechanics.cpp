@@ -468,7 +468,7 @@ MicroAnalysis MicroAnalyzer::analyse(const MicroNetwork& net) const {
   }
   if (nc == 0) return m;
 
-  // Fabric ([O] eq. 2.39–2.52; PHYSICS.md §7.5): R = <n⊗n>, a^r = 15/2·R'; the fourth-order term
+  // Fabric ([O] eq. 2.39–2.52; docs/physics.md §11): R = <n⊗n>, a^r = 15/2·R'; the fourth-order term
   // 315/8·dev4(<nnnn>) (Kanatani 1984) from the same contacts.
   m.fabric = fabric / static_cast<double>(nc);
   const Mat3 ar = 7.5 * deviator(m.fabric);

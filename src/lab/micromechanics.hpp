@@ -1,5 +1,5 @@
 #pragma once
-// Micromechanical analysis of a contact network (PHYSICS.md §7.5, [O] ch. 2 and 6): coordination
+// Micromechanical analysis of a contact network (docs/physics.md §11, [O] ch. 2 and 6): coordination
 // and rattlers, fabric, orientation-class averages of forces and branch vectors, their second-order
 // (optionally fourth-order) anisotropies, and the stress rebuilt from them (stress–force–fabric).
 // Pure functions over a plain description of the network, independent of how the engine stores
@@ -144,7 +144,7 @@ double norm4(const Tensor4& t);                      // √(t::t)
 // q/p along `axis`: (σ_aa − (σ_bb + σ_cc)/2) / (tr σ / 3); null when p ≤ 0.
 std::optional<double> qOverP(const Mat3& stress, int axis);
 
-// Time-series columns (README, INTERFACE.md): which set a run uses is fixed by whether the
+// Time-series columns (README, docs/interface.md): which set a run uses is fixed by whether the
 // assembly has ellipsoids and whether the fourth-order terms are on.
 struct MicroColumnSet {
   bool nonSpherical = false;

@@ -1,5 +1,5 @@
 #pragma once
-// Random loose placement of spheres without overlaps in a cubic box or periodic cell (LAB.md test 1).
+// Random loose placement of spheres without overlaps in a cubic box or periodic cell (docs/laboratory.md §1).
 #include <vector>
 
 #include "core/simulation.hpp"

@@ -1,4 +1,4 @@
-// Sample preparation (LAB.md test 1): loose placement, then compaction with a preparation friction
+// Sample preparation (docs/laboratory.md §1): loose placement, then compaction with a preparation friction
 // (searched to meet a target e0) or frictionless radius growth, then equilibrium at full stiffness
 // with the contact friction restored.
 #include <fmt/format.h>

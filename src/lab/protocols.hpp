@@ -1,5 +1,5 @@
 #pragma once
-// Laboratory protocols (LAB.md tests 1–5) in a box of rigid walls or a periodic cell: sample
+// Laboratory protocols (docs/laboratory.md §1–2) in a box of rigid walls or a periodic cell: sample
 // preparation (compaction with a preparation friction searched to meet a target e0, or frictionless
 // radius growth), isotropic consolidation, and the shearing tests: drained triaxial compression,
 // compression at constant mean stress, true triaxial at constant b, and simple shear at constant
@@ -32,7 +32,7 @@ class Laboratory;
 // Called to write a checkpoint (between steps, during shearing).
 using CheckpointFn = std::function<void(const Laboratory& lab)>;
 
-// One row of the time series (PHYSICS.md §0 signs: compression positive, eps_v > 0 contraction).
+// One row of the time series (docs/physics.md §1 signs: compression positive, eps_v > 0 contraction).
 struct Record {
   long step = 0;
   double time = 0.0;
@@ -64,7 +64,7 @@ struct Record {
   // could not be measured (written as an empty field, null).
   static constexpr std::size_t kMicroColumns = 40;
   std::array<double, kMicroColumns> micro{};
-  // Energy balance ([W] §4.9, PHYSICS.md §7.6) since the start of shearing, as a fraction of the
+  // Energy balance ([W] §4.9, docs/physics.md §10) since the start of shearing, as a fraction of the
   // external work: (W - dE_elastic - dE_kinetic - D_slip - D_roll - D_damping) / W; NaN while W = 0.
   double energyResidual = 0.0;
   // Triaxial unload–reload loops (test.unload_reload_at): 0 monotonic loading, 1 unloading,

@@ -45,7 +45,7 @@ struct GradingConfig {
   }
 };
 
-// Grain shape ([O], PHYSICS.md §1): spheres, or triaxial ellipsoids a >= b >= c of the same volume
+// Grain shape ([O], docs/physics.md §2): spheres, or triaxial ellipsoids a >= b >= c of the same volume
 // as the sphere drawn from the grading (equivalent radius), grown from it at the end of preparation.
 struct ShapeConfig {
   std::string type = "sphere";      // "sphere" | "ellipsoid"

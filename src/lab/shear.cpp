@@ -1,4 +1,4 @@
-// The shearing tests (LAB.md tests 3–5), in a wall box or a periodic cell: drained triaxial
+// The shearing tests (docs/laboratory.md §2), in a wall box or a periodic cell: drained triaxial
 // compression (lateral stresses held at p, axial strain rate imposed), compression at constant mean
 // stress ([O]: the lateral stresses follow (3p - sigma1)/2), true triaxial at constant p and b, and
 // simple shear at constant normal stress (cell only).

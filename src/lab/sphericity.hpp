@@ -1,5 +1,5 @@
 #pragma once
-// Per-grain rolling friction from true sphericity ([R], PHYSICS.md §3.2): each grain draws its
+// Per-grain rolling friction from true sphericity ([R], docs/physics.md §4.2): each grain draws its
 // sphericity psi from a measured distribution (a list of values or a histogram), seeded; psi is
 // capped at 1 and mu_r = c psi^k.
 #include <algorithm>

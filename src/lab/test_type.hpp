@@ -1,5 +1,5 @@
 #pragma once
-// The laboratory tests (LAB.md): one enumeration, parsed once from test.type (io/config.cpp), with
+// The laboratory tests (docs/laboratory.md): one enumeration, parsed once from test.type (io/config.cpp), with
 // what the rest of the laboratory needs to know about each test in one table.
 #include <array>
 #include <optional>

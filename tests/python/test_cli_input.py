@@ -1,5 +1,5 @@
 """Bad input gets exit code 2 and one line on stderr naming the key, the value and what is allowed;
-the INTERFACE.md example is accepted as written."""
+the docs/interface.md example is accepted as written."""
 import json
 import math
 import os

@@ -277,3 +277,46 @@ def test_links_to_headings_resolve(page):
         if not os.path.exists(os.path.join(DOCS, target)):
             broken.append(f"{target}: no such file")
     assert not broken, broken
+
+
+def tracked_text_files():
+    out = subprocess.run(["git", "-C", ROOT, "ls-files", "src", "tests", "tools", "python", "bench", "scripts", "docs",
+                          "README.md", "examples", "presets"], capture_output=True, text=True)
+    if out.returncode != 0:
+        pytest.skip("not a git checkout")
+    suffixes = (".cpp", ".hpp", ".py", ".md", ".toml", ".sh", ".txt")
+    return [p for p in out.stdout.split() if p.endswith(suffixes)]
+
+
+def test_citations_are_to_the_repository_docs_and_their_sections_exist():
+    # The project's docs stand alone: no citation of the specification files outside the repository
+    # (PHYSICS.md, LAB.md, INTERFACE.md, numbered differently), and every "docs/<page>.md §N" cited
+    # names a numbered heading of that page.
+    spec = re.compile(r"(?<![\w/])(PHYSICS|LAB|INTERFACE)\.md")
+    cited = re.compile(r"docs/(physics|laboratory|interface)\.md((?: §\d+(?:\.\d+)?(?:–\d+)?,?)+)")
+    headings = {}
+    for page in ("physics", "laboratory", "interface"):
+        nums = set()
+        for line in read("docs", page + ".md").splitlines():
+            m = re.match(r"#+ (\d+(?:\.\d+)?)\.? ", line)
+            if m:
+                nums.add(m.group(1))
+        headings[page] = nums
+    bad, missing = [], []
+    this = os.path.relpath(__file__, ROOT)
+    for path in tracked_text_files():
+        if os.path.normpath(path) == os.path.normpath(this):
+            continue
+        try:
+            text = read(path)
+        except (UnicodeDecodeError, FileNotFoundError):
+            continue
+        for n, line in enumerate(text.splitlines(), 1):
+            if spec.search(line):
+                bad.append(f"{path}:{n}: {line.strip()[:100]}")
+            for m in cited.finditer(line):
+                for sec in re.findall(r"§(\d+(?:\.\d+)?)", m.group(2)):
+                    if sec not in headings[m.group(1)]:
+                        missing.append(f"{path}:{n}: docs/{m.group(1)}.md §{sec}")
+    assert not bad, "citations of the specification outside the repository:\n" + "\n".join(bad)
+    assert not missing, "cited sections that the page does not have:\n" + "\n".join(missing)

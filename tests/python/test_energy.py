@@ -1,4 +1,4 @@
-"""Energy balance over whole laboratory tests ([W] §4.9, PHYSICS.md energy ledger): the work of the
+"""Energy balance over whole laboratory tests ([W] §4.9, docs/physics.md §10): the work of the
 boundaries equals kinetic + elastic energy + slip, rolling and damping dissipation. The residual is
 recomputed here from the recorded terms (not read from the program's own energy_residual column
 alone) and must stay within 1 % of the external work over the whole test, for the [W] law with

@@ -270,7 +270,7 @@ def test_contact_copy_against_the_engine(sim):
     assert n > 0 and all(len(v) == n for v in c.values())
     assert np.allclose(c["normal_force"] + c["tangential_force"], c["force"])
     assert np.allclose(np.einsum("ij,ij->i", c["tangential_force"], c["normal"]), 0.0, atol=1e-12)
-    # Love-Weber stress from the copy (pairs: f (x) branch; walls: -f (x) arm, PHYSICS.md §7.1) equals
+    # Love-Weber stress from the copy (pairs: f (x) branch; walls: -f (x) arm, docs/physics.md §9) equals
     # the engine's contact stress.
     f, l, wall = c["force"], c["branch"], c["wall"]
     sigma = (np.einsum("ci,cj->ij", f[~wall], l[~wall]) - np.einsum("ci,cj->ij", f[wall], l[wall])) / sim.volume

@@ -7,8 +7,8 @@
 //    positions and the mid-step velocities after a step, changes by dt sum (x x F + T) = 0 (the
 //    position update x += v dt adds v x v = 0). A force or moment given to one body of a contact with
 //    the wrong sign, or to the wrong body, breaks one of these at once.
-//  - Energy: kinetic + elastic + slip and rolling dissipation stays the initial energy (PHYSICS.md
-//    §7.6), to the leapfrog's O(dt^2) error (contact moments off: see tests/README.md).
+//  - Energy: kinetic + elastic + slip and rolling dissipation stays the initial energy (docs/physics.md
+//    §10), to the leapfrog's O(dt^2) error (contact moments off: see tests/README.md).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -99,7 +99,7 @@ TEST(FreeCluster, NewtonThirdLawMomentumAndAngularMomentum) {
   for (const Wall& w : sim.box.walls) EXPECT_EQ(w.contacts, 0);
 }
 
-// Energy (PHYSICS.md §7.6): with no damping and no walls, kinetic + elastic + slip dissipation
+// Energy (docs/physics.md §10): with no damping and no walls, kinetic + elastic + slip dissipation
 // stays the initial kinetic energy, at every step, to the leapfrog's O(dt^2) error. Contact moments
 // are off here (beta = 0): see tests/README.md for why the ledger does not close with them.
 TEST(FreeCluster, EnergyBalanceWithSliding) {

@@ -39,7 +39,7 @@ struct PinnedPair {
 
 }  // namespace
 
-// Kozicki–Donzé ([W], PHYSICS.md §3.1): bending. Hand numbers for rA = 1 mm, rB = 1.5 mm, U = 1 um:
+// Kozicki–Donzé ([W], docs/physics.md §4.1): bending. Hand numbers for rA = 1 mm, rB = 1.5 mm, U = 1 um:
 // Kn = 2 Ec rA rB/(rA + rB) = 3.6e7 N/m, |Fn| = 36 N, Ks = 1.08e7 N/m, Kr = beta Ks rA rB =
 // 2.43 N m/rad, limit eta (rA + rB)/2 |Fn| = 0.045 N m. B turns about +z relative to A, so the
 // moment resists it: B receives -Kr dtheta ez (A the opposite), up to the limit, then stays there;
@@ -87,7 +87,7 @@ TEST(BodyMoment, KozickiTwisting) {
   }
 }
 
-// Linear rolling resistance ([R], PHYSICS.md §3.2): bending only. R = rA rB/(rA + rB) = 0.6 mm,
+// Linear rolling resistance ([R], docs/physics.md §4.2): bending only. R = rA rB/(rA + rB) = 0.6 mm,
 // kr = Ks R^2 = 1.08e7 x 3.6e-7 = 3.888 N m/rad, limit mu_r |Fn| R with mu_r = min(0.3, 0.1) = 0.1:
 // 0.1 x 36 x 6e-4 = 2.16e-3 N m. Twisting meets no resistance at all.
 TEST(BodyMoment, RollingLinearBendingOnlyNoTwisting) {

@@ -1,4 +1,4 @@
-// The leapfrog with Cundall local damping (PHYSICS.md §4) on one body under a constant load,
+// The leapfrog with Cundall local damping (docs/physics.md §5) on one body under a constant load,
 // against the closed form of the damped scheme: per component, the load F is replaced by
 // F - alpha sgn(v) |F| with v the mid-step velocity, so
 //   v_{n+1} = v_n + (1 - alpha) F dt / m   while v_n and F have the same sign (damping resists the

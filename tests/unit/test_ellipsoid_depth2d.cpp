@@ -1,4 +1,4 @@
-// Overlap depth against an exact 2D solution ([O]'s check, PHYSICS.md §6): ellipsoids with one
+// Overlap depth against an exact 2D solution ([O]'s check, docs/physics.md §3): ellipsoids with one
 // principal axis along z and their centres in the plane z = 0 meet in that symmetry plane, where
 // their sections are ellipses. The exact depth of two overlapping ellipses is their penetration
 // depth, the shortest translation that separates them: min over unit u of h_A(u) + h_B(u) - u.R

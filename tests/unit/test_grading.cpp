@@ -1,4 +1,4 @@
-// The grading sampler (src/lab/grading.*, LAB.md test 1) against the curves it samples: 1e5 draws
+// The grading sampler (src/lab/grading.*, docs/laboratory.md §1) against the curves it samples: 1e5 draws
 // of a sieve curve have the curve's d10, d30, d50, d60 by mass and its mass fraction in every sieve
 // interval; a range uniform by number has the moments of the uniform distribution.
 //

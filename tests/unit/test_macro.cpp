@@ -1,4 +1,4 @@
-// Macro-parameters (PHYSICS.md §7.3) extracted from synthetic triaxial curves with known answers.
+// Macro-parameters (docs/laboratory.md §4) extracted from synthetic triaxial curves with known answers.
 #include <gtest/gtest.h>
 
 #include <cmath>

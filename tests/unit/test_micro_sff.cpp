@@ -71,7 +71,7 @@ Mat3 sphereMean(F&& integrand) {
   return s / (4.0 * kPi);
 }
 
-// m_v f0 l0 ∫ E F̂ ⊗ L̂ dΩ evaluated pointwise from the definitions (PHYSICS.md §7.5, [O] ch. 6).
+// m_v f0 l0 ∫ E F̂ ⊗ L̂ dΩ evaluated pointwise from the definitions (docs/physics.md §11, [O] ch. 6).
 Mat3 quadratureStress(const SffTerms& t) {
   return t.mv * t.f0 * t.l0 * sphereMean([&](const Vec3& n) -> Mat3 {
            double e = 1.0 + n.dot(t.ar * n);

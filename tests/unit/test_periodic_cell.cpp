@@ -1,4 +1,4 @@
-// The periodic cell (PHYSICS.md §5.2) against independent expectations: affine motion, images
+// The periodic cell (docs/physics.md §8.2) against independent expectations: affine motion, images
 // across faces, history through wrapping, momentum, rigid rotation, the servo, size limits.
 #include <gtest/gtest.h>
 

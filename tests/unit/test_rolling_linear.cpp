@@ -1,4 +1,4 @@
-// The linear rolling-resistance law of [R] (PHYSICS.md §3.2), the per-grain rolling friction from
+// The linear rolling-resistance law of [R] (docs/physics.md §4.2), the per-grain rolling friction from
 // sphericity, and grain kinematics, against hand-computed values.
 #include <gtest/gtest.h>
 

@@ -51,7 +51,7 @@ TEST(WallServo, SingleSpringFollowsTheDiscretePiResponse) {
   sim.particles.addSphere(Vec3::Zero(), R, 2600.0);
   sim.particles.setMass(0, 1e300, 1e300);
   const double area = (2 * L) * (2 * L);
-  const double kn = 2.0 * 30e9 * R;          // sphere against a wall [PHYSICS.md §3.1]
+  const double kn = 2.0 * 30e9 * R;          // sphere against a wall [docs/physics.md §4.1]
   const double targetOverlap = target * area / kn;  // 6.67e-7 m
   Wall& top = sim.box.upper(2);
   top.position = R - 0.5 * targetOverlap;    // starts at half the target overlap

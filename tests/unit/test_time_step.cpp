@@ -1,4 +1,4 @@
-// The critical time step (src/core/time_step.cpp, PHYSICS.md §4) of a given small sample against
+// The critical time step (src/core/time_step.cpp, docs/physics.md §7) of a given small sample against
 // sqrt(m/k) worked out by hand for both contact models.
 //
 // The engine takes, per sphere, the stiffest contact it can have (against a wall): translation

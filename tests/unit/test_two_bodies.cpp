@@ -20,7 +20,7 @@ TEST(HeadOnCollision, DurationRestitutionEnergy) {
   sim.particles.velocity[0] = Vec3(v0, 0, 0);
   sim.particles.velocity[1] = Vec3(-v0, 0, 0);
   sim.initialise();
-  const double kn = 30e9 * R;  // Kn = 2 Ec R R/(R + R) [PHYSICS.md §3.1], by hand
+  const double kn = 30e9 * R;  // Kn = 2 Ec R R/(R + R) [docs/physics.md §4.1], by hand
   const double m = sim.particles.mass[0];
   const double expected = kPi * std::sqrt(0.5 * m / kn);
   sim.dt = expected / 2000.0;

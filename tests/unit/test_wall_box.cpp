@@ -1,5 +1,5 @@
 // A small sample in the wall box (lab::Laboratory): the Love–Weber stress from the contacts equals
-// the stress the walls measure (PHYSICS.md §7.1) at isotropic equilibrium and at a deviatoric
+// the stress the walls measure (docs/physics.md §9) at isotropic equilibrium and at a deviatoric
 // state during drained triaxial compression. The identity behind it is statics: summed over every
 // contact of every particle, f (x) (x_c - x_p) leaves only the wall contacts and the particles' net
 // forces, and the wall terms are (wall force) x (box length) / V = the wall stress. So the two agree

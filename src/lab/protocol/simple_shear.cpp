@@ -1,4 +1,4 @@
-// Simple shear in the periodic cell (LAB.md test 5): L_xz imposed, no lateral strain (the x and y
+// Simple shear in the periodic cell (docs/laboratory.md §2): L_xz imposed, no lateral strain (the x and y
 // edges keep their length); drained, the normal stress sigma_zz held; undrained, H_zz fixed too, so
 // the volume is constant and u is the fall of sigma_zz from its initial value.
 #include <cmath>

@@ -1,4 +1,4 @@
-// Triaxial compression (LAB.md test 3): axial strain rate imposed; drained, the lateral stresses
+// Triaxial compression (docs/laboratory.md §2): axial strain rate imposed; drained, the lateral stresses
 // held at the confining pressure; undrained, the lateral axes keep the volume (the dry-sample
 // analogue of an undrained test on saturated sand, u the change of lateral total stress the
 // constraint produces).
