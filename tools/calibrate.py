@@ -216,7 +216,18 @@ def optimise(evaluator, space, settings):
     opt.set_upper_bounds([1.0] * n)
     opt.set_maxeval(settings["max_evaluations"])
     opt.set_xtol_abs(settings["xtol"])
-    opt.set_initial_step(settings["initial_step"])
+    # BOBYQA needs its first steps inside the bounds and silently moves a start nearer a bound than
+    # the step; so the step of such a parameter is cut to its distance from the bound, and the
+    # first point evaluated is the start the user gave. A start on a bound is moved (said so).
+    start = space.start()
+    steps = []
+    for j, u in enumerate(start):
+        room = min(u, 1.0 - u)
+        steps.append(min(settings["initial_step"], room) if room >= 0.01 else settings["initial_step"])
+        if room < 0.01 and settings["algorithm"] == "bobyqa" and not getattr(evaluator, "quiet", False):
+            print(f"calibrate: parameter {j + 1}'s start is on its bound; bobyqa starts "
+                  f"{settings['initial_step']:g} of its range inside", file=sys.stderr, flush=True)
+    opt.set_initial_step(steps)
     if settings["stop_objective"] is not None:
         opt.set_stopval(settings["stop_objective"])
     counter = [0]
@@ -232,7 +243,7 @@ def optimise(evaluator, space, settings):
     opt.set_min_objective(objective)
     reason = "maximum evaluations reached"
     try:
-        opt.optimize(space.start())
+        opt.optimize(start)
         reason = {nlopt.SUCCESS: "converged", nlopt.STOPVAL_REACHED: "stop_objective reached",
                   nlopt.FTOL_REACHED: "objective tolerance reached", nlopt.XTOL_REACHED: "xtol reached",
                   nlopt.MAXEVAL_REACHED: "maximum evaluations reached"}.get(opt.last_optimize_result(), "stopped")

@@ -167,3 +167,37 @@ def test_trade_off_is_named_with_its_direction():
     out = calibrate_report.analyse(space, problem, best, neighbours, 0.05)
     assert out["condition_number"] == pytest.approx(1.0)
     assert not any("trade off" in s for s in out["statements"])
+
+
+@pytest.mark.parametrize("algorithm", ["bobyqa", "neldermead"])
+def test_the_first_point_evaluated_is_the_start_even_near_a_bound(algorithm):
+    # friction start 15 in [10, 40] is 1/6 of the range from its bound, less than the default first
+    # step (0.25): BOBYQA would move it to 0.25 (17.5 deg) unless the step is cut to the room left.
+    import calibrate
+    space = Space([{"key": "contact.friction_deg", "min": 10.0, "max": 40.0, "start": 15.0, "log": False},
+                   {"key": "contact.eta", "min": 0.05, "max": 1.0, "start": 0.9, "log": False}])
+
+    class Quadratic:
+        quiet = True
+
+        def __init__(self):
+            self.points = []
+            self.history = []
+
+        def evaluate(self, named_points, kind):
+            out = []
+            for name, u in named_points:
+                self.points.append(list(u))
+                out.append({"name": name, "objective": (u[0] - 0.4) ** 2 + (u[1] - 0.6) ** 2, "failed": None,
+                            "u": list(u), "kind": kind})
+            self.history += out
+            return out
+
+    ev = Quadratic()
+    settings = {"algorithm": algorithm, "max_evaluations": 12, "xtol": 1e-6, "initial_step": 0.25,
+                "stop_objective": None, "seed": 1}
+    calibrate.optimise(ev, space, settings)
+    assert ev.points[0] == pytest.approx(space.start(), abs=1e-12)
+    assert space.values(ev.points[0]) == pytest.approx([15.0, 0.9], rel=1e-12)
+    # every point inside the bounds
+    assert all(0.0 <= x <= 1.0 for p in ev.points for x in p)
