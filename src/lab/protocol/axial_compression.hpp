@@ -18,7 +18,7 @@ class AxialCompression : public ShearProtocol {
 
  protected:
   // The path's targets before the tension cut (x, y).
-  virtual Vec3 pathTargets(double sigma1) const { return Vec3(config_.test.confiningPressure, config_.test.confiningPressure, 0.0); }
+  virtual Vec3 pathTargets(double /*sigma1*/) const { return Vec3(config_.test.confiningPressure, config_.test.confiningPressure, 0.0); }
   // Whether the targets follow sigma1 (set before every step).
   virtual bool followsAxialStress() const { return false; }
 };
