@@ -846,6 +846,13 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.sample.method = s.string("method", c.sample.method,
                              {"compaction", "growth", "lattice", "loose-moment-free", "deposition", "under-compaction"});
   c.sample.layers = static_cast<int>(s.integer("layers", c.sample.layers, 2, 50));
+  // Every layer is a cloud of its own: an empty one has nothing to place (and a layer of a few grains
+  // is no layer).
+  if (c.sample.method == "under-compaction" && c.sample.layers > c.sample.nParticles / 10)
+    fail("sample.layers", std::to_string(c.sample.layers),
+         fmt::format("allowed: at most sample.n_particles / 10 = {} (each layer needs 10 grains or more; "
+                     "under-compaction needs sample.n_particles >= 20)",
+                     c.sample.nParticles / 10));
   c.sample.underCompaction = s.number("under_compaction", c.sample.underCompaction, 0.0, 0.3, false, false,
                                       "must be in [0, 0.3] (the bottom layer's dry density below that of e0, as a "
                                       "fraction; 0: every layer tamped to e0)");

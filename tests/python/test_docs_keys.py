@@ -122,6 +122,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "dt": '[solver]\ndt = 1e-7\n',
         "hertz-mindlin": '[contact]\nmodel = "hertz-mindlin"\n',
         "deposition": '[sample]\nmethod = "deposition"\n',
+        "under-compaction": '[sample]\nmethod = "under-compaction"\n',
     }
     printed = {}
     for name, text in configs.items():

@@ -68,6 +68,8 @@ def test_under_compaction_is_deterministic_and_reported(tmp_path):
     (['test.boundary="periodic"'], "sample.gravity"),
     (['sample.shape={type="ellipsoid", elongation=0.7}'], "sample.method"),
     (["sample.gravity=[0, -9.81, 0]"], "sample.gravity"),
+    (["sample.n_particles=2"], "sample.layers"),           # empty layers (placement had nothing to place)
+    (["sample.n_particles=30", "sample.layers=5"], "sample.layers"),
 ])
 def test_bad_under_compaction_input_exits_2_naming_the_key(tmp_path, extra, key):
     base = TAMP
