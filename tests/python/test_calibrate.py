@@ -306,7 +306,7 @@ key = "contact.young"
 min = 3.0e9
 max = 3.0e10
 log = true
-start = 5.0e9
+start = 5.3348e9   # u = 0.25 of the log range: the first step (0.25) fits inside it
 [[target]]
 key = "E50_MPa"
 value = {truth[50e3]!r}
@@ -344,7 +344,7 @@ enabled = false
     assert [t["key"] for t in result["fit"]["targets"]] == ["E50_MPa@50kPa", "E50_MPa@200kPa"]
     assert [c["quantity"] for c in result["fit"]["curves"]] == ["q@50kPa"]
     # The objective is zero at the truth (common random numbers) but rough around it (a DEM sample
-    # is chaotic: measured 1.12e10, objective 0.0016 against 0.17 at the start, in 7 evaluations).
+    # is chaotic: measured 8.64e9, objective 0.0033 against 0.16 at the start, in 7 evaluations).
     assert best["objective"] < 0.05 * result["start"]["objective"]
     assert abs(best["parameters"]["contact.young"] / 1e10 - 1.0) < 0.2, best
     report = (out / "report.md").read_text()
