@@ -4,27 +4,18 @@ last layer ends the stack at e0: the cube's side); each layer's tamping reported
 tamper reached its height (it stops at the confining pressure); thin layers warned about; bad input
 exits 2 naming the key. The solid volume of a slice (the void ratio profile) and the slab placement
 against hand numbers: tests/unit/test_layers.cpp."""
-import subprocess
-
 import pytest
 
-from conftest import GRAINLAB
-from test_lab_tests import CONFIG, read
+from test_gravity import run as run_cli
 
 TAMP = ["sample.n_particles=150", 'sample.grading={type="uniform", d_min=4e-3, d_max=6e-3}',
         'sample.method="under-compaction"', "sample.layers=2", "sample.e0=0.75", 'test.type="isotropic"',
         "sample.prep_friction_deg=10", "output.plots=false", "output.vtk_every_strain=0", "output.save_packing=true"]
 
 
-def args(extra):
-    return [a for s in extra for a in ("--set", s)]
-
-
 def run(out, *extra, base=TAMP, check=0):
-    proc = subprocess.run([GRAINLAB, "run", CONFIG, "--out", str(out), "--quiet", "--threads", "1", *args(list(base) + list(extra))],
-                          capture_output=True, text=True, timeout=600)
-    assert proc.returncode == check, proc.stderr
-    return (read(out) if check == 0 else None), proc
+    # test_gravity's runner (grainlab run on the small-triaxial config, one thread) with the tamping's keys.
+    return run_cli(out, *extra, base=base, check=check)
 
 
 def test_under_compaction_is_deterministic_and_reported(tmp_path):
