@@ -14,7 +14,11 @@ from test_lab_tests import CONFIG, read
 
 DEPOSIT = ["sample.n_particles=150", 'sample.grading={type="uniform", d_min=4e-3, d_max=6e-3}',
            'sample.method="deposition"', "sample.drop_height=0.01", 'test.type="isotropic"', "sample.prep_friction_deg=30",
-           "output.plots=false", "output.vtk_every_strain=0", "output.save_packing=true"]
+           "output.plots=false", "output.vtk_every_strain=0", "output.save_packing=true",
+           # No small-strain probe: on this loose bed its lateral servo does not come back within 1 %
+           # of the tiny axial increment and ran its 2e6-step cap (50 s of a 51 s run; not what is
+           # tested here).
+           "test.probe_strain=0"]
 
 
 def args(extra):
@@ -56,6 +60,11 @@ def test_gravity_on_a_triaxial_books_its_work(tmp_path):
     # The platens squeeze the sample down onto the fixed pedestal: the grains sink, gravity works.
     assert c["W_gravity"][-1] > 0
     assert s["energy_residual_max"] is not None and s["energy_residual_max"] < 0.02
+    # The small-strain probe settles under gravity: its reference state is judged on the platen that
+    # holds p, not on the mean axial stress (which carries the weight on the pedestal besides p and
+    # never came to p: the probe ran its 2e6-step cap and reported no E0).
+    assert s["E0_probe"]["settled"] is True and s["E0_probe"]["steps"] < 100000, s["E0_probe"]
+    assert s["E0_MPa"] > 0 and 0 < s["nu0"] < 0.5
     # Without gravity the column is absent.
     (c0, _), _ = run(tmp_path / "n", "sample.n_particles=150", "contact.young=3e8", "test.final_axial_strain=0.005",
                      "output.plots=false", "output.vtk_every_strain=0", base=[])
