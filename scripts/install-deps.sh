@@ -4,7 +4,7 @@
 set -euo pipefail
 PKGS=(build-essential cmake pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev
-      python3 python3-numpy python3-matplotlib python3-pytest python3-meshio
+      python3 python3-numpy python3-matplotlib python3-pytest python3-pytest-xdist python3-meshio
       libboost-dev)  # libboost-dev: header-only Boost.Math (Gauss–Legendre rules, micromechanics)
 # Checksums of checkpoints and packing files (xxHash), for the program and the Python readers.
 PKGS+=(libxxhash-dev python3-xxhash)

@@ -43,10 +43,12 @@ const std::vector<std::string> kCurveQuantities{"q", "sigma1_over_sigma3", "eps_
 constexpr std::uintmax_t kMaxCurveBytes = 16u << 20;
 constexpr std::size_t kMaxCurveRows = 100000;
 
+// A value or path for a message, within 80 characters: a long one keeps its start and its end
+// (a path's file name, which says which file is meant) around "...".
 std::string cut(std::string s) {
   for (char& c : s)
     if (c == '\n' || c == '\r') c = ' ';
-  return s.size() > 80 ? s.substr(0, 77) + "..." : s;
+  return s.size() > 80 ? s.substr(0, 38) + "..." + s.substr(s.size() - 39) : s;
 }
 
 std::string show(const toml::node& node) {
