@@ -3,7 +3,7 @@
 # on every core with pytest-xdist); then the command-line program again under AddressSanitizer +
 # UndefinedBehaviorSanitizer (the `asan` preset of CMakePresets.json, build-asan/, target grainlab
 # only), where any report fails: the fuzzer's forged checkpoints and packings (the binary files a
-# user gets from someone else; ~95 s) and one short whole run. The whole fuzzer and the hostile
+# user gets from someone else; 95-170 s) and one short whole run. The whole fuzzer and the hostile
 # configs under ASan took 6 min (they run in the release build above); the unit tests under the
 # sanitizers are a developer command (tests/README.md, *Sanitizers*): building them too doubled the
 # sanitizer build (6 -> 11.5 min on 2 cores).
@@ -31,4 +31,4 @@ OMP_WAIT_POLICY=passive build-asan/grainlab run tests/data/small-triaxial.toml -
   --set output.plots=false --set output.vtk_every_strain=0.001 --set output.checkpoint_every=0.001 \
   --set sample.prep_ramp_steps=2000 --set solver.unbalanced_tolerance=0.05 \
   --set solver.stress_tolerance=0.05 --set solver.servo_integral_steps=20
-echo "sanitizers: the hostile-input tests and a short run clean under ASan + UBSan"
+echo "sanitizers: forged checkpoints and packings and a short run clean under ASan + UBSan"
