@@ -259,7 +259,7 @@ int main(int argc, char** argv) {
   // renormalisation.
   const double tSphereRotation = timeBatch([&] {
     for (int i = 0; i < kPairs; ++i) {
-      const Vec3 td = rotation::localDampingTorque(torque[i], w[i], 0.3);
+      const Vec3 td = rotation::localDamping(torque[i], w[i], 0.3);
       w[i] += (torque[i] + td) * (1.0 / inertia[i].x());
       const Vec3 half = 0.5 * w[i];
       q[i] = rotation::renormalised(Quat(1.0, half.x(), half.y(), half.z()) * q[i]);

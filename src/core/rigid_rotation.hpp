@@ -20,6 +20,7 @@
 #include <limits>
 
 #include "core/types.hpp"
+#include "core/kernels/damping.hpp"
 
 namespace grainlab::rotation {
 
@@ -124,30 +125,10 @@ inline RotationStep rotateUnderMomentum(const Quat& q, const Vec3& angularMoment
   return out;
 }
 
-// Cundall local damping of a torque (docs/physics.md §5), per world component against the sign of the
-// mid-step angular velocity; returns the damping torque to add (0 where w_k = 0).
-inline Vec3 localDampingTorque(const Vec3& torque, const Vec3& omegaMid, double alpha) {
-  Vec3 td;
-  for (int k = 0; k < 3; ++k) {
-    td[k] = -alpha * std::copysign(std::abs(torque[k]), omegaMid[k]) * (omegaMid[k] != 0.0);
-  }
-  return td;
-}
-
-// [O]'s viscous mass/inertia-proportional damping, x'' + alpha x' = F/m and (generalised with the
-// gyroscopic term) dL/dt = T - alpha L, by the midpoint rule of [O] eq. 3.27-3.28 (Cundall &
-// Strack 1979): (p_new - p_old)/dt = F - alpha (p_old + p_new)/2 for a momentum p (m v or L).
-struct ViscousKick {
-  Vec3 momentum;       // p^(n+1/2)
-  Vec3 dampingForce;   // -alpha (p_old + p_new)/2: the damping force (torque) over the step
-};
-inline ViscousKick viscousMidpointKick(const Vec3& momentum, const Vec3& force, double alpha, double dt) {
-  const double ha = 0.5 * alpha * dt;
-  ViscousKick k;
-  k.momentum = ((1.0 - ha) * momentum + dt * force) / (1.0 + ha);
-  k.dampingForce = -0.5 * alpha * (momentum + k.momentum);
-  return k;
-}
+// The damping laws (core/kernels/damping.hpp), shared with the translational and sphere updates.
+using kernels::localDamping;
+using kernels::viscousMidpointKick;
+using kernels::ViscousKick;
 
 enum class Damping { None, Local, Viscous };
 
@@ -172,7 +153,7 @@ inline LeapfrogRotation leapfrogRotationWithMomentum(const Quat& q, const Vec3& 
     out.angularMomentum = k.momentum;
     out.dampingTorque = k.dampingForce;
   } else {
-    out.dampingTorque = damping == Damping::Local ? localDampingTorque(torque, omegaMid, alpha) : Vec3::Zero();
+    out.dampingTorque = damping == Damping::Local ? localDamping(torque, omegaMid, alpha) : Vec3::Zero();
     out.angularMomentum = l0 + dt * (torque + out.dampingTorque);
   }
   // Guess for w^(n+1/2): w^(n-1/2) advanced over dt by the kick and by the gyroscopic turn of the

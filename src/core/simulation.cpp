@@ -13,6 +13,8 @@
 
 #include "core/contact_driver.hpp"
 #include "core/errors.hpp"
+#include "core/kernels/gather.hpp"
+#include "core/kernels/integrate.hpp"
 #include "core/parallel.hpp"
 #include "core/state_io.hpp"
 #include "core/rigid_rotation.hpp"
@@ -229,28 +231,9 @@ void Simulation::computeContacts() {
 }
 
 void Simulation::gatherParticle(std::size_t i) {
-  // Each particle sums its own contacts, kind by kind, in a fixed order: no races, and the sums do
-  // not depend on the number of threads (bit-identical results for any thread count).
-  Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-  contacts.forEach([&](const auto& list) {
-    using Kind = typename std::decay_t<decltype(list)>::KindType;
-    for (std::uint32_t s = list.incidentStart[i]; s < list.incidentStart[i + 1]; ++s) {
-      const std::uint32_t e = list.incident[s];
-      const std::uint32_t c = e >> 1;
-      if constexpr (Kind::kPlane) {  // the force of the wall on the particle
-        fi += list.force[c];
-        ti += list.torqueA[c];
-      } else if (e & 1u) {  // the particle is body B: the force of A on it
-        fi += list.force[c];
-        ti += list.torqueB[c];
-      } else {
-        fi -= list.force[c];
-        ti += list.torqueA[c];
-      }
-    }
-  });
-  particles.force[i] = fi;
-  particles.torque[i] = ti;
+  const kernels::Wrench sum = kernels::gatherParticle(contacts, i);  // core/kernels/gather.hpp
+  particles.force[i] = sum.force;
+  particles.torque[i] = sum.torque;
 }
 
 void Simulation::measureBoundary() {
@@ -428,110 +411,54 @@ void Simulation::integrate() {
   else integrateFor<false>();
 }
 
-namespace {
-// Cundall's local damping, -alpha |f_k| sign(v_k) per component (nothing where v_k = 0), as one
-// array expression: built component by component, it went through the stack and was read back
-// with a wider load than it was written with (a store-forwarding stall, the integrator's hottest
-// instructions in the profile). Multiplying by sign(v) = +-1 is exact, so the bits are those of
-// copysign(|f_k|, v_k).
-inline Vec3 localDampingForce(const Vec3& f, const Vec3& v, double alpha) {
-  return ((-alpha) * f.array().abs() * v.array().sign()).matrix();
-}
-}  // namespace
-
 template <bool Periodic>
 void Simulation::integrateFor() {
-  auto& x = particles.position;
-  auto& v = particles.velocity;
-  auto& q = particles.orientation;
-  auto& w = particles.angularVelocity;
-  const auto& xBuild = broadPhase.positionsAtBuild();
-  const double alpha = localDamping;
-  const bool viscous = viscousDamping > 0.0;
-  const double h = dt;
-  const bool gravityOn = gravity.squaredNorm() > 0.0;
-  const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
+  // The per-particle kernel (core/kernels/integrate.hpp) over a view of the arrays; this loop only
+  // shares the particles out, gathers each one's contacts and keeps the chunk sums.
+  const kernels::IntegratorView view = kernels::IntegratorView::of(particles);
+  kernels::IntegratorStep stepParams;
+  stepParams.h = dt;
+  stepParams.localDamping = localDamping;
+  stepParams.viscousDamping = viscousDamping;
+  stepParams.gravity = gravity;
+  stepParams.gravityOn = gravity.squaredNorm() > 0.0;
   // Periodic cell: particles move with the homogeneous flow too, x <- x + v h + M x, the same map
   // M = exp(L h) - I that advanced H; the rebuild test measures displacements from where that flow
   // has carried each particle's build position (F x_build, F = H H_build^-1).
-  const Mat3 flowStep = cell.flowStep(h);
+  stepParams.flowStep = cell.flowStep(dt);
+  const auto& x = particles.position;
+  const auto& v = particles.velocity;
+  const auto& w = particles.angularVelocity;
+  const auto& xBuild = broadPhase.positionsAtBuild();
+  const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   const Mat3 deformation = Periodic ? broadPhase.cellDeformation(cell) : Mat3::Identity();
   // Per chunk: the IntegrateSum terms; the sums were cut for the particles by the contact stage.
   ChunkedSums& sums = integrateSums_;
 
 #pragma omp for schedule(static)
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
-  double work = 0.0, gravityWork = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
-  for (std::size_t i = sums.begin(chunk); i < sums.end(chunk); ++i) {
-    gatherParticle(i);
-    // Cundall local damping per component, against the sign of the current (mid-step) velocity.
-    Vec3 f = particles.force[i] + particles.mass[i] * gravity;
-    Vec3 t = particles.torque[i];
-    Vec3 fd, td;
-    const Vec3 vOld = v[i], wOld = w[i];
-    if (viscous) {
-      // [O] eq. 3.27-3.28: (p_new - p_old)/dt = F - alpha (p_old + p_new)/2, p = m v or I w (L).
-      const rotation::ViscousKick kick = rotation::viscousMidpointKick(particles.mass[i] * v[i], f, viscousDamping, h);
-      fd = kick.dampingForce;
-      v[i] = kick.momentum * particles.invMass[i];
-    } else {
-      fd = localDampingForce(f, v[i], alpha);
-      v[i] += (f + fd) * (h * particles.invMass[i]);
-    }
-    if (particles.shape[i] == Shape::Ellipsoid) {
-      // Distinct principal moments: the rotational leapfrog of core/rigid_rotation.hpp (Euler's
-      // equations with the gyroscopic term, second order, angular momentum kept exact; local damping
-      // on the torque against the mid-step spin, as for spheres).
-      const rotation::LeapfrogRotation r = rotation::leapfrogRotationWithMomentum(
-          q[i], w[i], particles.angularMomentum[i], particles.principalInertia[i], t, h,
-          viscous ? rotation::Damping::Viscous : (alpha > 0.0 ? rotation::Damping::Local : rotation::Damping::None),
-          viscous ? viscousDamping : alpha);
-      td = r.dampingTorque;
-      w[i] = r.step.angularVelocity;
-      q[i] = r.step.orientation;
-      particles.angularMomentum[i] = r.angularMomentum;
-    } else {
-      if (viscous) {
-        const rotation::ViscousKick kick = rotation::viscousMidpointKick(particles.inertia[i] * w[i], t, viscousDamping, h);
-        td = kick.dampingForce;
-        w[i] = kick.momentum * particles.invInertia[i];
-      } else {
-        td = localDampingForce(t, w[i], alpha);
-        w[i] += (t + td) * (h * particles.invInertia[i]);
+    double work = 0.0, gravityWork = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
+    for (std::size_t i = sums.begin(chunk); i < sums.end(chunk); ++i) {
+      gatherParticle(i);
+      const kernels::ParticleWork pw = kernels::integrateParticle<Periodic>(view, i, stepParams);
+      work += pw.damping;
+      if (stepParams.gravityOn) gravityWork += pw.gravity;
+      if (!xBuild.empty()) {
+        if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
+        else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
       }
-      if (w[i].squaredNorm() > 0.0) {
-        // q <- exp(w dt / 2) q with the exponential to first order, renormalised (docs/physics.md §6).
-        const Vec3 half = 0.5 * h * w[i];
-        Quat qn = Quat(1.0, half.x(), half.y(), half.z()) * q[i];
-        // |qn|^2 = 1 + eps with eps ~ |w dt|^2 / 4 (~1e-10): 1/sqrt(1 + eps) by its series
-        // 1 - eps/2 + 3 eps^2/8, exact to round-off below 1e-6; the square root otherwise.
-        const double eps = qn.coeffs().squaredNorm() - 1.0;
-        qn.coeffs() *= std::abs(eps) < 1e-6 ? 1.0 - 0.5 * eps + 0.375 * eps * eps : 1.0 / std::sqrt(1.0 + eps);
-        q[i] = qn;
+      const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
+      bool inside = true;
+      if constexpr (!Periodic) {
+        const double r = particles.radius[i];
+        inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
       }
+      if ((!finite || !inside) && !(badParticle < static_cast<double>(i))) badParticle = static_cast<double>(i);
     }
-    // Work of the damping forces over the step, with the mean of old and new velocities.
-    work += h * (fd.dot(0.5 * (vOld + v[i])) + td.dot(0.5 * (wOld + w[i])));
-    if constexpr (Periodic) x[i] += v[i] * h + flowStep * x[i];
-    else x[i] += v[i] * h;
-    // Gravity's work is exact for the leapfrog: the particle moves by v h under the constant m g.
-    if (gravityOn) gravityWork += particles.mass[i] * gravity.dot(v[i]) * h;
-    if (!xBuild.empty()) {
-      if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
-      else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
-    }
-    const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
-    bool inside = true;
-    if constexpr (!Periodic) {
-      const double r = particles.radius[i];
-      inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
-    }
-    if ((!finite || !inside) && !(badParticle < static_cast<double>(i))) badParticle = static_cast<double>(i);
-  }
-  sums.at(chunk, kDampingWork) = work;
-  sums.at(chunk, kDisp2) = maxDisp2;
-  sums.at(chunk, kBadParticle) = badParticle;
-  sums.at(chunk, kGravityWork) = gravityWork;
+    sums.at(chunk, kDampingWork) = work;
+    sums.at(chunk, kDisp2) = maxDisp2;
+    sums.at(chunk, kBadParticle) = badParticle;
+    sums.at(chunk, kGravityWork) = gravityWork;
   }
   serial([&] { finishIntegration<Periodic>(deformation); });
 }

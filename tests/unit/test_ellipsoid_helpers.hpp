@@ -128,7 +128,7 @@ struct Body {
       v = rotation::viscousMidpointKick(m * v, f, alpha, dt).momentum / m;
     } else {
       Vec3 fd = Vec3::Zero();
-      if (damping == rotation::Damping::Local) fd = rotation::localDampingTorque(f, v, alpha);
+      if (damping == rotation::Damping::Local) fd = rotation::localDamping(f, v, alpha);
       v += (f + fd) * (dt / m);
     }
     const rotation::LeapfrogRotation r = rotation::leapfrogRotation(q, w, inertia, t, dt, dt, damping, alpha);

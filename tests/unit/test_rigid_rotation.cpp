@@ -224,7 +224,7 @@ TEST(RigidRotation, ViscousMidpointDamping) {
 
 TEST(RigidRotation, LocalDampingOpposesEachComponentOfTheMotion) {
   const Vec3 t(2.0, -3.0, 0.5), w(-1.0, -2.0, 0.0);
-  const Vec3 td = localDampingTorque(t, w, 0.3);
+  const Vec3 td = localDamping(t, w, 0.3);
   EXPECT_DOUBLE_EQ(td.x(), 0.6);   // w_x < 0: pushes +
   EXPECT_DOUBLE_EQ(td.y(), 0.9);
   EXPECT_DOUBLE_EQ(td.z(), 0.0);   // w_z = 0: no damping
