@@ -4,13 +4,15 @@
 // integration, clock) and the stages a laboratory protocol adds around them (drives, load-cell
 // averages, recorders, snapshots, checkpoints, stop conditions), each with a trigger. A protocol
 // builds one pipeline and runs it until a stage asks to stop; `describe()` prints the order.
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "core/simulation.hpp"
+
 namespace grainlab {
 
-class Simulation;
 
 // When a pipeline stage runs: every `every` steps of the run (counting from 1 after the first step's
 // engine stages), and only while `when` (if given) says so.
@@ -25,6 +27,7 @@ struct StageTrigger {
 class Pipeline {
  public:
   using Action = std::function<void()>;
+  using ParticleAction = std::function<void(std::size_t begin, std::size_t end)>;
   using Trigger = StageTrigger;
 
   // A pipeline holding the engine stages of `sim`, in the engine's order.
@@ -34,6 +37,13 @@ class Pipeline {
   void addBefore(std::string name, Action action, Trigger trigger = {});
   // Adds a stage after everything added so far (recorders, checks).
   void addAfter(std::string name, Action action, Trigger trigger = {});
+  // Adds a stage that runs inside every step, right after the engine stage `afterEngineStage`
+  // (any but "clock"), on the step's threads: `body(begin, end)` handles particles [begin, end)
+  // and writes only to them (Simulation::InnerStage). `reads` and `writes` are Simulation::Access
+  // bits, shown by describeAccess(). E.g. a per-grain record of the velocities the integrator just
+  // set, without a serial pass over all particles after the step.
+  void addInside(std::string name, const std::string& afterEngineStage, ParticleAction body, unsigned reads,
+                 unsigned writes);
 
   // Asks the run to end after the current step; later stages of this step still run unless they
   // check stopping().
@@ -46,16 +56,23 @@ class Pipeline {
   // The stage names in order, e.g. for the results summary and the docs.
   std::vector<std::string> names() const;
   std::string describe() const;
+  // One line per stage: its name, where it runs and what it reads and writes (engine and inner
+  // stages; the others run between steps and may touch anything).
+  std::string describeAccess() const;
 
  private:
+  enum class Place { Outside, Engine, Inside };
   struct Stage {
     std::string name;
     Action action;
     Trigger trigger;
-    bool engine;  // engine stages run every step, before the step counter advances
+    Place place;      // Engine and Inside stages run within sim_.step(), every step
+    std::size_t engineIndex = 0;  // Engine: its index; Inside: the engine stage it follows
+    unsigned reads = 0, writes = 0;
   };
   Simulation& sim_;
   std::vector<Stage> stages_;
+  std::vector<Simulation::InnerStage> inner_;
   std::size_t firstEngine_ = 0;
   bool stopping_ = false;
   long steps_ = 0;

@@ -25,14 +25,34 @@ namespace grainlab {
 const std::vector<Simulation::EngineStage>& Simulation::engineStages() {
   // The engine's pipeline, in order: the one place where the step is defined.
   static const std::vector<EngineStage> stages{
-      {"broad phase", &Simulation::updateBroadPhase},
-      {"contacts", &Simulation::computeContacts},
-      {"boundary forces", &Simulation::measureBoundary},
-      {"boundary control", &Simulation::controlBoundary},
-      {"integrate", &Simulation::integrate},
-      {"clock", &Simulation::advanceClock},
+      {"broad phase", &Simulation::updateBroadPhase, true, kPositions | kBoundary | kContacts,
+       kPositions | kContacts},
+      {"contacts", &Simulation::computeContacts, false, kPositions | kVelocities | kRotations | kContacts | kBoundary,
+       kContacts | kEnergy | kBoundary},
+      {"boundary forces", &Simulation::measureBoundary, false, kContacts | kBoundary, kBoundary},
+      {"boundary control", &Simulation::controlBoundary, true, kBoundary, kBoundary | kEnergy},
+      {"integrate", &Simulation::integrate, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary,
+       kPositions | kVelocities | kRotations | kForces | kEnergy},
+      {"clock", &Simulation::advanceClock, true, kClock, kClock},
   };
   return stages;
+}
+
+std::size_t Simulation::engineStageIndex(const std::string& name) {
+  const auto& stages = engineStages();
+  for (std::size_t k = 0; k < stages.size(); ++k)
+    if (name == stages[k].name) return k;
+  throw std::invalid_argument("no engine stage called \"" + name + "\"");
+}
+
+std::string Simulation::accessNames(unsigned access) {
+  static const char* const names[] = {"positions", "velocities", "rotations", "forces", "contacts",
+                                      "boundary", "energy", "clock", "laboratory records"};
+  std::string out;
+  for (unsigned b = 0; b < std::size(names); ++b)
+    if (access & (1u << b)) out += (out.empty() ? "" : ", ") + std::string(names[b]);
+  return out.empty() ? "nothing" : out;
 }
 
 void Simulation::initialise(double skinFraction) {
@@ -47,7 +67,12 @@ namespace {
 thread_local int tStage = 0;
 }  // namespace
 
-void Simulation::step() {
+namespace {
+// Particles per call of an inner stage's body: the team shares these blocks out statically.
+constexpr std::size_t kInnerBlock = 256;
+}  // namespace
+
+void Simulation::step(const std::vector<InnerStage>* inner) {
   // One parallel region per step: the stages share the team (one fork/join instead of one per
   // parallel stage). Every thread runs every stage and so meets the same work-sharing constructs
   // and barriers in the same order: outside serial parts, stages branch only on what no thread
@@ -57,11 +82,22 @@ void Simulation::step() {
   const std::vector<EngineStage>& stages = engineStages();
   failedStage_.stage.store(StageFlag::kNone, std::memory_order_relaxed);
   stageError_ = nullptr;
+  auto runInner = [&](std::size_t after) {
+    for (const InnerStage& st : *inner) {
+      if (st.after != after) continue;
+      const std::size_t n = particles.size();
+      // The loop's closing barrier publishes the stage's writes to the next stage.
+#pragma omp for schedule(static)
+      for (std::size_t begin = 0; begin < n; begin += kInnerBlock) st.particles(begin, std::min(n, begin + kInnerBlock));
+    }
+  };
   auto runStages = [&] {
     for (int k = 0; k < static_cast<int>(stages.size()); ++k) {
       if (failedStage_.stage.load(std::memory_order_relaxed) < k) break;
       tStage = k;
       (this->*stages[k].run)();
+      if (failedStage_.stage.load(std::memory_order_relaxed) <= k) break;  // its serial part failed
+      if (inner && !inner->empty()) runInner(static_cast<std::size_t>(k));
     }
   };
 #ifdef _OPENMP

@@ -11,6 +11,7 @@
 #include <array>
 #include <atomic>
 #include <exception>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -78,17 +79,47 @@ class Simulation {
   // Critical time step (docs/physics.md §7): min over particles of sqrt(m/Kn) and sqrt(I/K_theta) for
   // the stiffest contact the particle can have (against a wall).
   double criticalTimeStep() const;
+  // What a stage reads and writes, declared with the stage (docs/architecture.md, "One step").
+  enum Access : unsigned {
+    kNothing = 0,
+    kPositions = 1u << 0,         // positions, images
+    kVelocities = 1u << 1,        // translational velocities
+    kRotations = 1u << 2,         // orientations, angular velocities and momenta
+    kForces = 1u << 3,            // per-particle force and torque
+    kContacts = 1u << 4,          // contact lists, their history and results
+    kBoundary = 1u << 5,          // walls or cell: geometry, velocities, servo state, stresses
+    kEnergy = 1u << 6,            // the energy ledger
+    kClock = 1u << 7,             // step count and time
+    kLaboratory = 1u << 8,        // the laboratory's own records (outside the engine)
+  };
+  // Names of the set bits, e.g. "positions, velocities".
+  static std::string accessNames(unsigned access);
+
+  // A stage from outside the engine (a laboratory pipeline's, core/pipeline.hpp) that step() runs
+  // inside the step, right after engine stage `after`. Its body gets a range [begin, end) of
+  // particles and may write only to items in that range; every thread of the step's team runs it on
+  // its static share, so the result does not depend on the thread count. It must not throw.
+  struct InnerStage {
+    std::size_t after = 0;  // index in engineStages()
+    std::function<void(std::size_t begin, std::size_t end)> particles;
+  };
   // One step: every engine stage in order, inside one OpenMP parallel region (one fork/join per
-  // step). Stages share the team: loops are work-shared, serial parts run on one thread between
-  // barriers (serial()). An error in a serial part skips the rest of the step and is rethrown here.
-  void step();
+  // step), with `inner` stages (if given) after the engine stages they name. Stages share the team:
+  // loops are work-shared, serial parts run on one thread between barriers (serial()). An error in
+  // a serial part skips the rest of the step and is rethrown here.
+  void step(const std::vector<InnerStage>* inner = nullptr);
 
   // The engine stages, in the order step() runs them.
   struct EngineStage {
     const char* name;
     void (Simulation::*run)();
+    bool serial;      // runs on one thread (the others wait); otherwise its loops are shared out
+    unsigned reads;   // Access bits
+    unsigned writes;  // Access bits
   };
   static const std::vector<EngineStage>& engineStages();
+  // The index of the engine stage called `name` (std::invalid_argument when there is none).
+  static std::size_t engineStageIndex(const std::string& name);
 
   // Volume enclosed by the boundary [m^3].
   double volume() const { return boundary == Boundary::Periodic ? cell.volume() : box.volume(); }

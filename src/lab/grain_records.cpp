@@ -19,9 +19,10 @@ void GrainRecords::reset(const Simulation& sim) {
   referenceCell = sim.cell.h;
 }
 
-void GrainRecords::accumulateRotation(const Particles& particles, double dt) {
+void GrainRecords::accumulateRotation(const Particles& particles, double dt, std::size_t begin, std::size_t end) {
   const auto& w = particles.angularVelocity;
-  for (std::size_t i = 0; i < rotationPath.size(); ++i) {
+  end = std::min(end, rotationPath.size());
+  for (std::size_t i = begin; i < end; ++i) {
     const double wNorm = w[i].norm();
     if (wNorm > 0.0) rotationPath[i] += wNorm * dt;
   }

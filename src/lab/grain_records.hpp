@@ -19,8 +19,9 @@ struct GrainRecords {
 
   // Starts the record anew from the current state (sphericity is kept, or set to 1).
   void reset(const Simulation& sim);
-  // Adds |omega| dt of the step just taken (a recorder stage after the engine's integration).
-  void accumulateRotation(const Particles& particles, double dt);
+  // Adds |omega| dt of the step just taken to particles [begin, end) (an inner stage of the step,
+  // right after the engine's integration, shared out by particle).
+  void accumulateRotation(const Particles& particles, double dt, std::size_t begin, std::size_t end);
   // Angle [rad] of the composed rotation of particle i since its reference orientation.
   double rotationAngle(const Particles& particles, std::size_t i) const;
   // Displacement of particle i since the reference, continued through the faces of a periodic cell.

@@ -163,7 +163,10 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
   auto last = std::make_shared<bool>(false);
 
   pipeline.addBefore("loading drive", [this, &protocol, &b, &st] { protocol.drive(b, st.result.strainRate, loadingFactor()); });
-  pipeline.addAfter("rotation record", [this] { records_.accumulateRotation(sim_.particles, sim_.dt); });
+  pipeline.addInside(
+      "rotation record", "integrate",
+      [this](std::size_t begin, std::size_t end) { records_.accumulateRotation(sim_.particles, sim_.dt, begin, end); },
+      Simulation::kRotations, Simulation::kLaboratory);
   pipeline.addAfter("protocol", [&protocol, &b] { protocol.afterStep(b); });
   pipeline.addAfter("load cell", [this, &st, &protocol, &b, strain, axial, last] {
     const Mat3 sc = sim_.boundary == Boundary::Periodic ? sim_.cell.stress : Mat3::Zero();

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/pipeline.hpp"
 #include "test_helpers.hpp"
 
 using namespace grainlab;
@@ -86,4 +87,57 @@ TEST(EngineStep, WallSumsAreTheSameOnOneAndTwoThreads) {
   EXPECT_GT(one[0], 0.0);
   EXPECT_GT(one[2], 50.0);
   for (std::size_t k = 0; k < one.size(); ++k) EXPECT_EQ(one[k], two[k]) << "term " << k;
+}
+
+// A pipeline's inner stage (Pipeline::addInside) runs inside every step right after the engine
+// stage it names, once per particle, on one thread or two: here it records each particle's speed
+// after "integrate" and after "boundary forces" (before the integrator moves anything), and the
+// records must equal what the particles hold at those points, for both thread counts.
+TEST(EngineStep, InnerStagesRunAfterTheirEngineStageForEveryParticle) {
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    Simulation sim = sparseLattice();
+    for (std::size_t i = 0; i < sim.particles.size(); ++i) sim.particles.velocity[i] = Vec3(1e-3 * (i % 7), 0.0, 0.0);
+    sim.gravity = Vec3(0.0, 0.0, -9.81);
+    const std::size_t n = sim.particles.size();
+    std::vector<double> before(n, -1.0), after(n, -1.0);
+    std::vector<int> calls(n, 0);
+    Pipeline pipeline(sim);
+    pipeline.addInside("after integrate", "integrate", [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        after[i] = sim.particles.velocity[i].z();
+        ++calls[i];
+      }
+    }, Simulation::kVelocities, Simulation::kLaboratory);
+    pipeline.addInside("before integrate", "boundary forces", [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) before[i] = sim.particles.velocity[i].z();
+    }, Simulation::kVelocities, Simulation::kLaboratory);
+    std::vector<double> zBefore(n);
+    pipeline.addBefore("snapshot", [&] {
+      for (std::size_t i = 0; i < n; ++i) zBefore[i] = sim.particles.velocity[i].z();
+    });
+    pipeline.addAfter("stop", [&] {
+      if (pipeline.steps() == 3) pipeline.stop();
+    });
+    EXPECT_EQ(pipeline.describe(),
+              "snapshot -> broad phase -> contacts -> boundary forces -> before integrate -> boundary control -> "
+              "integrate -> after integrate -> clock -> stop");
+    EXPECT_NE(pipeline.describeAccess().find("after integrate: inside the step, shared out by particle; reads "
+                                             "velocities; writes laboratory records"),
+              std::string::npos)
+        << pipeline.describeAccess();
+    EXPECT_EQ(pipeline.run(), 3);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(calls[i], 3) << "particle " << i << " on " << threads << " threads";
+      EXPECT_EQ(before[i], zBefore[i]);  // the last step's velocity before its integration
+      EXPECT_EQ(after[i], sim.particles.velocity[i].z());
+      EXPECT_LT(after[i], before[i]);  // gravity pulled it down in between
+    }
+  }
+  omp_set_num_threads(1);
+  Simulation sim = sparseLattice();
+  Pipeline pipeline(sim);
+  auto none = [](std::size_t, std::size_t) {};
+  EXPECT_THROW(pipeline.addInside("late", "clock", none, 0, 0), std::invalid_argument);
+  EXPECT_THROW(pipeline.addInside("nowhere", "collisions", none, 0, 0), std::invalid_argument);
 }
