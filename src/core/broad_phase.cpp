@@ -29,13 +29,6 @@ void BroadPhase::loadState(std::istream& in) {
   get(in, cellAtBuildInverse_);
 }
 
-void BroadPhase::permute(const std::vector<std::uint32_t>& order) {
-  if (positionAtBuild_.size() != order.size()) return;
-  std::vector<Vec3> p(order.size());
-  for (std::size_t k = 0; k < order.size(); ++k) p[k] = positionAtBuild_[order[k]];
-  positionAtBuild_.swap(p);
-}
-
 bool BroadPhase::wallsMoved(const WallBox& box) const {
   for (int k = 0; k < 6; ++k)
     if (std::abs(box.walls[k].position - wallPositionAtBuild_[k]) > halfSkin()) return true;

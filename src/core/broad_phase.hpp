@@ -39,7 +39,6 @@ class BroadPhase {
   Mat3 cellDeformation(const PeriodicCell& cell) const { return cell.h * cellAtBuildInverse_; }
 
   const std::vector<Vec3>& positionsAtBuild() const { return positionAtBuild_; }
-  void permute(const std::vector<std::uint32_t>& order);
 
   void saveState(std::ostream& out) const;
   void loadState(std::istream& in);

@@ -127,42 +127,6 @@ class ContactList {
     slotsStale = true;
   }
 
-  // Renumbers particles: particle old index k is now at newIndex[k]; re-sorts keys with history.
-  // Pairs of an index-ordered kind are swapped where needed to keep a < b.
-  void renumber(const std::vector<std::uint32_t>& newIndex, std::size_t nParticles) {
-    std::vector<PairKey> keys(size());
-    for (std::size_t c = 0; c < size(); ++c) {
-      std::uint32_t x = newIndex[a[c]], y = Kind::kPlane ? b[c] : newIndex[b[c]];
-      std::uint32_t s = shift[c];
-      if (Kind::kIndexOrdered && y < x) {  // pairs are kept with a < b: swap the bodies, negate the shift
-        std::swap(x, y);
-        const auto v = ImageShift::unpack(s);
-        s = ImageShift::pack(-v[0], -v[1], -v[2]);
-      }
-      keys[c] = {x, y, s};
-    }
-    std::vector<std::uint32_t> order(size());
-    for (std::size_t c = 0; c < size(); ++c) order[c] = static_cast<std::uint32_t>(c);
-    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return keys[x] < keys[y]; });
-    std::vector<History> h(size());
-    std::vector<PairKey> sorted(size());
-    for (std::size_t c = 0; c < size(); ++c) {
-      sorted[c] = keys[order[c]];
-      h[c] = history[order[c]];
-      // A swapped pair's history was written from A's side: its shear force and moment are those of
-      // A on B, so they change sign with the roles, and the normal flips.
-      if (Kind::kIndexOrdered && newIndex[this->a[order[c]]] != sorted[c].a) {
-        h[c].shearForce = -h[c].shearForce;
-        h[c].moment = -h[c].moment;
-        h[c].prevNormal = -h[c].prevNormal;
-        if constexpr (std::is_same_v<History, contact::EllipsoidHistory>) h[c].lambda = 1.0 - h[c].lambda;
-      }
-    }
-    a.clear();
-    history.clear();
-    assign(sorted, nParticles);
-    history.swap(h);
-  }
 
   void saveState(std::ostream& out) const {
     using namespace stateio;

@@ -87,38 +87,6 @@ double Particles::solidVolume() const {
   return v;
 }
 
-namespace {
-template <class T>
-void applyOrder(std::vector<T>& v, const std::vector<std::uint32_t>& order) {
-  std::vector<T> out;
-  out.reserve(order.size());
-  for (std::uint32_t k : order) out.push_back(v[k]);
-  v.swap(out);
-}
-}  // namespace
-
-void Particles::permute(const std::vector<std::uint32_t>& order) {
-  applyOrder(id, order);
-  applyOrder(position, order);
-  applyOrder(velocity, order);
-  applyOrder(orientation, order);
-  applyOrder(angularVelocity, order);
-  applyOrder(force, order);
-  applyOrder(torque, order);
-  applyOrder(shape, order);
-  applyOrder(radius, order);
-  applyOrder(semiAxes, order);
-  applyOrder(mass, order);
-  applyOrder(inertia, order);
-  applyOrder(invMass, order);
-  applyOrder(invInertia, order);
-  applyOrder(rollingFriction, order);
-  applyOrder(image, order);
-  applyOrder(principalInertia, order);
-  applyOrder(angularMomentum, order);
-  applyOrder(equivalentRadius, order);
-}
-
 void Particles::saveState(std::ostream& out) const {
   using namespace stateio;
   putVector(out, id);

@@ -78,8 +78,6 @@ struct Particles {
   Vec3 unwrapped(std::size_t i, const Mat3& h) const {
     return position[i] + h * Vec3(image[i][0], image[i][1], image[i][2]);
   }
-  // Moves particle order[k] to position k in every array.
-  void permute(const std::vector<std::uint32_t>& order);
   // Exact binary state for checkpoints (state_io.hpp).
   void saveState(std::ostream& out) const;
   // Reads the stored arrays only; nothing is derived from them until deriveAfterLoad(), which the

@@ -581,20 +581,6 @@ std::size_t Simulation::touchingPairs() const {
   return count;
 }
 
-void Simulation::reorder(const std::vector<std::uint32_t>& order) {
-  const std::size_t n = particles.size();
-  if (order.size() != n) throw std::invalid_argument("reorder: the order must list every particle once");
-  std::vector<std::uint32_t> newIndex(n, ~0u);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (order[k] >= n || newIndex[order[k]] != ~0u)
-      throw std::invalid_argument("reorder: the order must list every particle once");
-    newIndex[order[k]] = static_cast<std::uint32_t>(k);
-  }
-  particles.permute(order);
-  contacts.forEach([&](auto& list) { list.renumber(newIndex, n); });
-  broadPhase.permute(order);
-}
-
 void Simulation::saveState(std::ostream& out) const {
   using namespace stateio;
   particles.saveState(out);

@@ -125,9 +125,6 @@ class Simulation {
   double volume() const { return boundary == Boundary::Periodic ? cell.volume() : box.volume(); }
   // Number of touching particle–particle contacts at the latest step.
   std::size_t touchingPairs() const;
-  // Moves particle order[k] to storage index k (ids stay with their particles); contacts, their
-  // history and the broad phase follow.
-  void reorder(const std::vector<std::uint32_t>& order);
 
   // Exact binary state for checkpoints: a loaded simulation continues bit for bit.
   void saveState(std::ostream& out) const;
