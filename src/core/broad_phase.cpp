@@ -1,7 +1,6 @@
 #include "core/broad_phase.hpp"
 
 #include <fmt/format.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -41,34 +40,6 @@ double BroadPhase::reach(const Particles& particles) const {
   return 2.0 * rMax + skin;
 }
 
-template <class Partners>
-std::vector<PairKey> BroadPhase::scanPairs(std::size_t n, Partners&& partners) {
-  // Each thread scans a contiguous range of a and lists its partners (b > a) in sorted order;
-  // ranges are concatenated in thread order, so the result equals the serial one.
-  const int nThreads = omp_get_max_threads();
-  std::vector<std::vector<PairKey>> perThread(nThreads);
-#pragma omp parallel num_threads(nThreads)
-  {
-    const int t = omp_get_thread_num();
-    const int nt = omp_get_num_threads();
-    const std::size_t begin = n * t / nt, end = n * (t + 1) / nt;
-    auto& out = perThread[t];
-    std::vector<PairKey> found;
-    for (std::size_t a = begin; a < end; ++a) {
-      found.clear();
-      partners(static_cast<std::uint32_t>(a), found);
-      std::sort(found.begin(), found.end());
-      out.insert(out.end(), found.begin(), found.end());
-    }
-  }
-  std::vector<PairKey> keys;
-  std::size_t total = 0;
-  for (auto& v : perThread) total += v.size();
-  keys.reserve(total);
-  for (auto& v : perThread) keys.insert(keys.end(), v.begin(), v.end());
-  return keys;
-}
-
 void BroadPhase::assignPairs(const Particles& particles, const std::vector<PairKey>& keys, ContactStore& contacts) {
   // Candidate pairs by the shapes of their bodies. A sphere–ellipsoid pair is keyed sphere first,
   // with the image shift of the ellipsoid (negated when the two trade places), and re-sorted.
@@ -97,10 +68,22 @@ void BroadPhase::assignPairs(const Particles& particles, const std::vector<PairK
 }
 
 void BroadPhase::buildWalls(const Particles& particles, const WallBox& box, ContactStore& contacts) {
+  prepareWalls(particles, box, 1);
+  scanPart(particles, PeriodicCell{}, 0);
+  finish(particles, box, PeriodicCell{}, contacts);
+}
+
+void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& cell, ContactStore& contacts) {
+  preparePeriodic(particles, cell, 1);
+  scanPart(particles, cell, 0);
+  finish(particles, WallBox{}, cell, contacts);
+}
+
+void BroadPhase::prepareWalls(const Particles& particles, const WallBox& box, int parts) {
+  (void)box;
   const std::size_t n = particles.size();
   const auto& x = particles.position;
   const auto& r = particles.radius;
-
   // Grid over the particles' bounding box; cell side >= largest interaction distance.
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   double rMax = 0.0;
@@ -109,45 +92,22 @@ void BroadPhase::buildWalls(const Particles& particles, const WallBox& box, Cont
     hi = hi.cwiseMax(x[i]);
     rMax = std::max(rMax, r[i]);
   }
-  const double cellSide = 2.0 * rMax + skin;
-  SpatialGrid::Cell dims{};
-  for (int a = 0; a < 3; ++a) dims[a] = SpatialGrid::cellsAlong(hi[a] - lo[a], cellSide);
-  auto cellOf = [&](const Vec3& p) {
-    SpatialGrid::Cell c{};
-    for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(p[a], lo[a], cellSide, dims[a]);
-    return c;
-  };
-  grid_.reset(dims);
-  for (std::size_t i = 0; i < n; ++i) grid_.insert(static_cast<std::uint32_t>(i), cellOf(x[i]));
-
-  const std::vector<PairKey> keys = scanPairs(n, [&](std::uint32_t a, std::vector<PairKey>& found) {
-    grid_.forEachAround(cellOf(x[a]), [&](std::uint32_t b) {
-      if (b <= a) return;
-      const double reach = r[a] + r[b] + skin;
-      if ((x[b] - x[a]).squaredNorm() < reach * reach) found.push_back({a, b, ImageShift::kZero});
-    });
-  });
-  assignPairs(particles, keys, contacts);
-
-  // Wall candidates, sorted by particle then wall, by shape.
-  std::vector<PairKey> wallKeys, ellipsoidWallKeys;
-  for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < 6; ++k)
-      if (box.walls[k].distance(x[i]) < r[i] + skin)
-        (particles.shape[i] == Shape::Sphere ? wallKeys : ellipsoidWallKeys)
-            .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), ImageShift::kZero});
-  contacts.sphereWall.assign(wallKeys, n);
-  contacts.ellipsoidWall.assign(ellipsoidWallKeys, n);
-
-  positionAtBuild_ = x;
-  for (int k = 0; k < 6; ++k) wallPositionAtBuild_[k] = box.walls[k].position;
-  ++builds;
+  periodicBuild_ = false;
+  gridLow_ = lo;
+  cellSide_ = 2.0 * rMax + skin;
+  for (int a = 0; a < 3; ++a) dims_[a] = SpatialGrid::cellsAlong(hi[a] - lo[a], cellSide_);
+  cellOf_.resize(n);
+  grid_.reset(dims_);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) cellOf_[i][a] = SpatialGrid::coordinate(x[i][a], lo[a], cellSide_, dims_[a]);
+    grid_.insert(static_cast<std::uint32_t>(i), cellOf_[i]);
+  }
+  parts_.assign(static_cast<std::size_t>(parts), {});
 }
 
-void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& cell, ContactStore& contacts) {
+void BroadPhase::preparePeriodic(const Particles& particles, const PeriodicCell& cell, int parts) {
   const std::size_t n = particles.size();
   const auto& x = particles.position;
-  const auto& r = particles.radius;
   const double range = reach(particles);
   const Vec3 widths = cell.widths();
   if (widths.minCoeff() < 2.0 * range)
@@ -158,28 +118,77 @@ void BroadPhase::buildPeriodic(const Particles& particles, const PeriodicCell& c
   // Grid in scaled coordinates: n_k cells along axis k, each at least `range` wide in real space
   // (the distance between the cell's faces is widths_k / n_k), so everything within range of a
   // point is in the 3x3x3 block around its cell (docs/physics.md §8.2).
-  const SpatialGrid::Cell dims = SpatialGrid::dimsFor({widths[0], widths[1], widths[2]}, range, std::max<std::size_t>(27, 4 * n));
-  std::vector<SpatialGrid::Cell> cellOf(n);
-  grid_.reset(dims);
+  periodicBuild_ = true;
+  dims_ = SpatialGrid::dimsFor({widths[0], widths[1], widths[2]}, range, std::max<std::size_t>(27, 4 * n));
+  cellOf_.resize(n);
+  grid_.reset(dims_);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 s = cell.hInverse * x[i];
-    for (int a = 0; a < 3; ++a) cellOf[i][a] = SpatialGrid::coordinate(s[a] * dims[a], 0.0, 1.0, dims[a]);
-    grid_.insert(static_cast<std::uint32_t>(i), cellOf[i]);
+    for (int a = 0; a < 3; ++a) cellOf_[i][a] = SpatialGrid::coordinate(s[a] * dims_[a], 0.0, 1.0, dims_[a]);
+    grid_.insert(static_cast<std::uint32_t>(i), cellOf_[i]);
   }
-  const std::vector<PairKey> keys = scanPairs(n, [&](std::uint32_t a, std::vector<PairKey>& found) {
-    grid_.forEachAroundPeriodic(cellOf[a], [&](std::uint32_t b, const SpatialGrid::Cell& s) {
-      if (b <= a) return;
-      const Vec3 image = x[b] + cell.h * Vec3(s[0], s[1], s[2]);
-      const double reachAB = r[a] + r[b] + skin;
-      if ((image - x[a]).squaredNorm() < reachAB * reachAB) found.push_back({a, b, ImageShift::pack(s[0], s[1], s[2])});
-    });
-  });
-  assignPairs(particles, keys, contacts);
-  contacts.sphereWall.assign({}, n);
-  contacts.ellipsoidWall.assign({}, n);
+  parts_.assign(static_cast<std::size_t>(parts), {});
+}
 
+void BroadPhase::scanPart(const Particles& particles, const PeriodicCell& cell, int part) {
+  // Part `part` of parts_.size(): a contiguous range of a, each a's partners (b > a) sorted.
+  const std::size_t n = particles.size(), parts = parts_.size(), t = static_cast<std::size_t>(part);
+  const std::size_t begin = n * t / parts, end = n * (t + 1) / parts;
+  const auto& x = particles.position;
+  const auto& r = particles.radius;
+  std::vector<PairKey>& out = parts_[t];
+  out.clear();
+  std::vector<PairKey> found;
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto a = static_cast<std::uint32_t>(i);
+    found.clear();
+    if (periodicBuild_) {
+      grid_.forEachAroundPeriodic(cellOf_[a], [&](std::uint32_t b, const SpatialGrid::Cell& s) {
+        if (b <= a) return;
+        const Vec3 image = x[b] + cell.h * Vec3(s[0], s[1], s[2]);
+        const double reachAB = r[a] + r[b] + skin;
+        if ((image - x[a]).squaredNorm() < reachAB * reachAB) found.push_back({a, b, ImageShift::pack(s[0], s[1], s[2])});
+      });
+    } else {
+      grid_.forEachAround(cellOf_[a], [&](std::uint32_t b) {
+        if (b <= a) return;
+        const double reach = r[a] + r[b] + skin;
+        if ((x[b] - x[a]).squaredNorm() < reach * reach) found.push_back({a, b, ImageShift::kZero});
+      });
+    }
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
+  }
+}
+
+void BroadPhase::finish(const Particles& particles, const WallBox& box, const PeriodicCell& cell,
+                        ContactStore& contacts) {
+  const std::size_t n = particles.size();
+  const auto& x = particles.position;
+  const auto& r = particles.radius;
+  std::vector<PairKey> keys;
+  std::size_t total = 0;
+  for (const auto& v : parts_) total += v.size();
+  keys.reserve(total);
+  for (const auto& v : parts_) keys.insert(keys.end(), v.begin(), v.end());
+  assignPairs(particles, keys, contacts);
+  if (periodicBuild_) {
+    contacts.sphereWall.assign({}, n);
+    contacts.ellipsoidWall.assign({}, n);
+    cellAtBuildInverse_ = cell.hInverse;
+  } else {
+    // Wall candidates, sorted by particle then wall, by shape.
+    std::vector<PairKey> wallKeys, ellipsoidWallKeys;
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 6; ++k)
+        if (box.walls[k].distance(x[i]) < r[i] + skin)
+          (particles.shape[i] == Shape::Sphere ? wallKeys : ellipsoidWallKeys)
+              .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), ImageShift::kZero});
+    contacts.sphereWall.assign(wallKeys, n);
+    contacts.ellipsoidWall.assign(ellipsoidWallKeys, n);
+    for (int k = 0; k < 6; ++k) wallPositionAtBuild_[k] = box.walls[k].position;
+  }
   positionAtBuild_ = x;
-  cellAtBuildInverse_ = cell.hInverse;
   ++builds;
 }
 

@@ -28,6 +28,17 @@ class BroadPhase {
   // Throws SimulationError when the cell is narrower than two interaction ranges.
   void buildPeriodic(const Particles& particles, const PeriodicCell& cell, ContactStore& contacts);
 
+  // The same rebuild in three phases, so that the candidate scan runs on the step's threads
+  // (Simulation::updateBroadPhase): prepare (one thread: bins the particles into the grid; the
+  // periodic one throws as buildPeriodic does), scanPart(part, parts) for every part (any thread,
+  // each part once: the candidates of a contiguous range of particles), finish (one thread: joins
+  // the parts in order and assigns the lists, carrying history). The parts' ranges are contiguous
+  // and each is sorted, so the lists do not depend on the number of parts.
+  void prepareWalls(const Particles& particles, const WallBox& box, int parts);
+  void preparePeriodic(const Particles& particles, const PeriodicCell& cell, int parts);
+  void scanPart(const Particles& particles, const PeriodicCell& cell, int part);
+  void finish(const Particles& particles, const WallBox& box, const PeriodicCell& cell, ContactStore& contacts);
+
   double halfSkin() const { return 0.5 * skin; }
   // Whether a wall moved more than skin/2 since the last build.
   bool wallsMoved(const WallBox& box) const;
@@ -48,11 +59,15 @@ class BroadPhase {
   std::array<double, 6> wallPositionAtBuild_{};
   Mat3 cellAtBuildInverse_ = Mat3::Identity();
   SpatialGrid grid_;
+  // The build under way: its boundary, its grid's geometry and the candidates found per part.
+  bool periodicBuild_ = false;
+  Vec3 gridLow_ = Vec3::Zero();
+  double cellSide_ = 0.0;
+  SpatialGrid::Cell dims_{};
+  std::vector<SpatialGrid::Cell> cellOf_;
+  std::vector<std::vector<PairKey>> parts_;
   // Distributes candidate pairs (sorted, a < b) to the pair kinds by shape.
   static void assignPairs(const Particles& particles, const std::vector<PairKey>& keys, ContactStore& contacts);
-  // Sorted keys of every particle pair within reach, from a parallel scan of `partners`.
-  template <class Partners>
-  std::vector<PairKey> scanPairs(std::size_t n, Partners&& partners);
 };
 
 }  // namespace grainlab

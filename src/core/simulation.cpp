@@ -144,15 +144,32 @@ void Simulation::advanceClock() {
 }
 
 void Simulation::updateBroadPhase() {
+  // Prepare on one thread (wrap, bin), scan the candidates on the whole team (one contiguous part
+  // of the particles per thread), finish on one thread (join in part order, carry history): the
+  // same lists for any thread count (BroadPhase::prepareWalls).
+#ifdef _OPENMP
+  const int team = omp_get_num_threads();
+#else
+  const int team = 1;
+#endif
   serial([&] {
+    rebuilding_ = false;
     if (boundary == Boundary::Periodic) {
       if (!rebuildDue_) return;
       wrapIntoCell();
-      broadPhase.buildPeriodic(particles, cell, contacts);
+      broadPhase.preparePeriodic(particles, cell, team);
     } else {
       if (!rebuildDue_ && !broadPhase.wallsMoved(box)) return;
-      broadPhase.buildWalls(particles, box, contacts);
+      broadPhase.prepareWalls(particles, box, team);
     }
+    rebuilding_ = true;
+  });
+  // Both read after the barrier that ended the serial part: every thread takes the same branch.
+  if (failedStage_.stage.load(std::memory_order_relaxed) == tStage || !rebuilding_) return;
+#pragma omp for schedule(static)
+  for (int part = 0; part < team; ++part) broadPhase.scanPart(particles, cell, part);
+  serial([&] {
+    broadPhase.finish(particles, box, cell, contacts);
     rebuildDue_ = false;
   });
 }

@@ -163,6 +163,7 @@ class Simulation {
   template <class F>
   void serial(F&& body);
   bool rebuildDue_ = true;
+  bool rebuilding_ = false;  // the broad phase is rebuilding in this step (set by its serial part)
   std::vector<geometry::Sym3> shapeMatrices_;  // scratch of the contact stage (ellipsoids)
   // Per-chunk sums of the step, shared by the team (core/parallel.hpp): contact energies and cell
   // terms per pair kind, then the integrator's terms below.

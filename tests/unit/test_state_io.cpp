@@ -60,8 +60,11 @@ static_assert(stateio::fieldCount<Particles>() == 19,
               "invInertia, equivalentRadius derived)");
 static_assert(stateio::fieldCount<contact::ContactHistory>() == 5, "ContactHistory changed: update state_io.hpp");
 static_assert(sizeof(BroadPhase) ==
-                  layoutSize<double, long, std::vector<Vec3>, std::array<double, 6>, Mat3, SpatialGrid>(),
-              "BroadPhase changed: update BroadPhase::saveState/loadState and this list (the grid is scratch)");
+                  layoutSize<double, long, std::vector<Vec3>, std::array<double, 6>, Mat3, SpatialGrid, bool, Vec3,
+                             double, SpatialGrid::Cell, std::vector<SpatialGrid::Cell>,
+                             std::vector<std::vector<PairKey>>>(),
+              "BroadPhase changed: update BroadPhase::saveState/loadState and this list (the grid and the fields "
+              "of a build under way, which never outlives a step, are scratch)");
 static_assert(sizeof(ContactList<SphereSphere>) ==
                   layoutSize<std::vector<std::uint32_t>, std::vector<std::uint32_t>, std::vector<std::uint32_t>,
                              std::vector<contact::ContactHistory>, std::vector<Vec3>, std::vector<Vec3>,
