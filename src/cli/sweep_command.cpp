@@ -477,6 +477,9 @@ int runSweep(const SweepOptions& opt) {
     }
   } else {
     std::map<pid_t, std::size_t> running;
+    std::map<pid_t, std::size_t> slots;  // the CPU block of each running job
+    const bool bindJobs = io::ompBindingRequested();
+    const std::vector<int> cpus = io::allowedCpus();
     std::size_t next = 0, done = kept;
     while (true) {
       while (!stop.stopSignal() && next < cases.size() && running.size() < static_cast<std::size_t>(opt.jobs)) {
@@ -486,9 +489,19 @@ int runSweep(const SweepOptions& opt) {
         if (threadsPerCase > 0) args.insert(args.end(), {"--threads", std::to_string(threadsPerCase)});
         for (const auto& s : opt.overrides) args.insert(args.end(), {"--set", s});
         for (const auto& [k, v] : cases[i]) args.insert(args.end(), {"--set", k + "=" + v});
+        // With OMP_PROC_BIND exported, each concurrent job gets its own CPUs (OMP_PLACES), or
+        // libgomp would bind every job's first thread to the same core.
+        std::size_t slot = 0;
+        while (std::any_of(running.begin(), running.end(), [&](const auto& r) { return slots[r.first] == slot; })) ++slot;
+        std::vector<std::string> env;
+        std::vector<int> jobCpus;
+        if (bindJobs) {
+          env.push_back("OMP_PLACES=" + io::ompPlacesFor(slot, std::max(threadsPerCase, 1), cpus));
+          jobCpus = io::cpusFor(slot, std::max(threadsPerCase, 1), cpus);
+        }
         pid_t pid;
         try {
-          pid = io::startProcess(args, io::ChildOutput::toFile(out / (names[i] + ".log")), true);
+          pid = io::startProcess(args, io::ChildOutput::toFile(out / (names[i] + ".log")), true, env, jobCpus);
         } catch (const io::FileError& e) {
           // Not started (e.g. its log cannot be written): the case failed; the others go on.
           std::fprintf(stderr, "grainlab: sweep: %s: %s\n", names[i].c_str(), io::printable(e.what(), 300).c_str());
@@ -498,6 +511,7 @@ int runSweep(const SweepOptions& opt) {
         }
         io::StopForwarding::track(pid);
         running[pid] = i;
+        slots[pid] = slot;
       }
       if (running.empty()) break;
       const auto [pid, code] = io::waitAnyProcess();
@@ -505,6 +519,7 @@ int runSweep(const SweepOptions& opt) {
       if (it == running.end()) continue;
       io::StopForwarding::untrack(pid);
       const std::size_t i = it->second;
+      slots.erase(it->first);
       running.erase(it);
       jobs[i].code = code;
       jobs[i].state = code == 0 ? State::Completed : stop.stopSignal() ? State::Stopped : State::Failed;

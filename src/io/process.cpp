@@ -1,9 +1,11 @@
 #include "io/process.hpp"
 
 #include <fcntl.h>
+#include <omp.h>
 #include <fmt/format.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sched.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,7 +14,11 @@
 #include <atomic>
 #include <cerrno>
 #include <csignal>
+#include <cctype>
+#include <cstdlib>
 #include <cstring>
+#include <string_view>
+#include <algorithm>
 
 #include "io/input_file.hpp"
 
@@ -39,7 +45,8 @@ FileError startError(const std::vector<std::string>& args, const ChildOutput& ou
 // fork + exec with PR_SET_PDEATHSIG in the child. Between fork and exec only async-signal-safe
 // calls (the process may have other threads); the reason of a failed start comes back through a
 // close-on-exec pipe (nothing read: exec succeeded).
-pid_t startTiedProcess(std::vector<std::string>& args, std::vector<char*>& pointers, const ChildOutput& output) {
+pid_t startTiedProcess(std::vector<std::string>& args, std::vector<char*>& pointers, const ChildOutput& output,
+                       char** envp, const cpu_set_t* cpus) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw FileError(fileErrorMessage("cannot start", args[0], errno));
   const pid_t parent = ::getpid();
@@ -60,6 +67,7 @@ pid_t startTiedProcess(std::vector<std::string>& args, std::vector<char*>& point
     // The parent may have ended before prctl: then this child is an orphan already and stops.
     if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0) err = errno;
     if (!err && ::getppid() != parent) ::_exit(127);
+    if (!err && cpus && ::sched_setaffinity(0, sizeof *cpus, cpus) != 0) err = errno;
     if (!err && output.kind != ChildOutput::Kind::Inherit) {
       const int flags = output.kind == ChildOutput::Kind::File ? O_WRONLY | O_CREAT | O_TRUNC : O_WRONLY;
       const int fd = ::open(file, flags, 0644);
@@ -71,7 +79,7 @@ pid_t startTiedProcess(std::vector<std::string>& args, std::vector<char*>& point
       sigset_t none;
       sigemptyset(&none);
       ::sigprocmask(SIG_SETMASK, &none, nullptr);
-      ::execve(args[0].c_str(), pointers.data(), environ);
+      ::execve(args[0].c_str(), pointers.data(), envp);
       err = errno;
     }
     [[maybe_unused]] const auto n = ::write(fds[1], &err, sizeof err);
@@ -94,13 +102,34 @@ pid_t startTiedProcess(std::vector<std::string>& args, std::vector<char*>& point
 
 }  // namespace
 
-pid_t startProcess(const std::vector<std::string>& argv, const ChildOutput& output, bool dieWithParent) {
+pid_t startProcess(const std::vector<std::string>& argv, const ChildOutput& output, bool dieWithParent,
+                   const std::vector<std::string>& environment, const std::vector<int>& cpus) {
   if (argv.empty()) throw FileError("startProcess: empty argument vector");
   std::vector<std::string> args = argv;  // posix_spawn takes char* const[]
   std::vector<char*> pointers;
   for (auto& a : args) pointers.push_back(a.data());
   pointers.push_back(nullptr);
-  if (dieWithParent) return startTiedProcess(args, pointers, output);
+  // The child's environment: ours, with the given NAME=value entries in place of their names'.
+  std::vector<std::string> env = environment;
+  std::vector<char*> envPointers;
+  char** envp = environ;
+  if (!env.empty()) {
+    auto nameOf = [](std::string_view e) { return e.substr(0, e.find('=')); };
+    for (char** e = environ; e && *e; ++e) {
+      bool replaced = false;
+      for (const auto& o : env) replaced = replaced || nameOf(o) == nameOf(*e);
+      if (!replaced) envPointers.push_back(*e);
+    }
+    for (auto& o : env) envPointers.push_back(o.data());
+    envPointers.push_back(nullptr);
+    envp = envPointers.data();
+  }
+  cpu_set_t cpuSet;
+  CPU_ZERO(&cpuSet);
+  for (int c : cpus)
+    if (c >= 0 && c < CPU_SETSIZE) CPU_SET(c, &cpuSet);
+  if (dieWithParent) return startTiedProcess(args, pointers, output, envp, cpus.empty() ? nullptr : &cpuSet);
+  if (!cpus.empty()) throw FileError("startProcess: a CPU set needs dieWithParent (fork and exec)");
   FileActions fa;
   if (output.kind == ChildOutput::Kind::Discard) {
     posix_spawn_file_actions_addopen(&fa.actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
@@ -111,10 +140,55 @@ pid_t startProcess(const std::vector<std::string>& argv, const ChildOutput& outp
     posix_spawn_file_actions_adddup2(&fa.actions, STDOUT_FILENO, STDERR_FILENO);
   }
   pid_t pid = 0;
-  const int rc = ::posix_spawn(&pid, args[0].c_str(), &fa.actions, nullptr, pointers.data(), environ);
+  const int rc = ::posix_spawn(&pid, args[0].c_str(), &fa.actions, nullptr, pointers.data(), envp);
   // The error may come from the program or from opening the log (posix_spawn reports either).
   if (rc != 0) throw startError(args, output, rc);
   return pid;
+}
+
+std::vector<int> allowedCpus() {
+  std::vector<int> out;
+  // With OMP_PROC_BIND set, libgomp has already bound this process's own thread to its first place
+  // (at load time), so the affinity mask says one CPU; its place list still holds every CPU of the
+  // mask the process started with.
+  if (ompBindingRequested()) {
+    for (int p = 0; p < omp_get_num_places(); ++p) {
+      std::vector<int> ids(static_cast<std::size_t>(omp_get_place_num_procs(p)));
+      omp_get_place_proc_ids(p, ids.data());
+      out.insert(out.end(), ids.begin(), ids.end());
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (!out.empty()) return out;
+  }
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (::sched_getaffinity(0, sizeof set, &set) == 0)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) out.push_back(c);
+  if (out.empty()) out.push_back(0);
+  return out;
+}
+
+std::vector<int> cpusFor(std::size_t slot, int threads, const std::vector<int>& cpus) {
+  const std::size_t t = static_cast<std::size_t>(std::max(threads, 1));
+  std::vector<int> out;
+  for (std::size_t k = 0; k < t; ++k) out.push_back(cpus.empty() ? 0 : cpus[(slot * t + k) % cpus.size()]);
+  return out;
+}
+
+std::string ompPlacesFor(std::size_t slot, int threads, const std::vector<int>& cpus) {
+  std::string places;
+  for (int cpu : cpusFor(slot, threads, cpus)) places += (places.empty() ? "{" : ",{") + std::to_string(cpu) + "}";
+  return places;
+}
+
+bool ompBindingRequested() {
+  const char* v = std::getenv("OMP_PROC_BIND");
+  if (!v || !*v) return false;
+  std::string s(v);
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s != "false";
 }
 
 int exitCodeOf(int status) {

@@ -26,7 +26,11 @@ struct ChildOutput {
 // (SIGKILL, prctl PR_SET_PDEATHSIG) when this process ends, however it ends, so a killed sweep leaves
 // no case writing into its folder; such a child is started with fork + exec (posix_spawn cannot
 // run code in the child), with only async-signal-safe calls between the two.
-pid_t startProcess(const std::vector<std::string>& argv, const ChildOutput& output = {}, bool dieWithParent = false);
+// `environment`: "NAME=value" entries that replace (or add to) this process's environment in the child.
+// `cpus` (dieWithParent only): the CPUs the child may run on, set before it starts (a bound parent's
+// mask is otherwise inherited, and libgomp drops every place outside it).
+pid_t startProcess(const std::vector<std::string>& argv, const ChildOutput& output = {}, bool dieWithParent = false,
+                   const std::vector<std::string>& environment = {}, const std::vector<int>& cpus = {});
 // The exit code of a finished child, or 128 + the signal number that ended it (as a shell reports).
 int exitCodeOf(int waitStatus);
 // Waits for one child; returns its exit code as exitCodeOf.
@@ -35,6 +39,19 @@ int waitProcess(pid_t pid);
 std::pair<pid_t, int> waitAnyProcess();
 // startProcess + waitProcess.
 int runProcess(const std::vector<std::string>& argv, const ChildOutput& output = {});
+
+// The CPUs this process may run on, in increasing order ({0} when unknown): sched_getaffinity, or
+// under OMP_PROC_BIND the CPUs of libgomp's places (the mask before libgomp bound this process).
+std::vector<int> allowedCpus();
+// OMP_PLACES for the job in slot `slot` of concurrent jobs of `threads` threads each on `cpus`: one
+// place per thread, "{c}" for consecutive CPUs of the slot's own block (wrapping round when the jobs
+// need more CPUs than there are). With OMP_PROC_BIND set, libgomp binds every process's first
+// thread to the first place, so without this every one-thread job of a sweep runs on the same core.
+std::string ompPlacesFor(std::size_t slot, int threads, const std::vector<int>& cpus);
+// The CPUs of that block, in the same order.
+std::vector<int> cpusFor(std::size_t slot, int threads, const std::vector<int>& cpus);
+// Whether OMP_PROC_BIND is set to something other than false (so places decide where threads run).
+bool ompBindingRequested();
 
 // While one is alive, SIGTERM, SIGINT and SIGHUP do not end this process: each is passed on to the
 // children registered with track() (which end by it), and stopSignal() says which came, so that the
