@@ -212,7 +212,7 @@ void printConfigWarnings(const lab::RunConfig& config) {
 
 std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   if (config.sample.grading.type == "list") {
-    const std::vector<double> list = lab::readDiameterList(config.sample.grading.file);
+    const std::vector<double>& list = config.sample.grading.list;  // read with the config (io/list_files.hpp)
     const auto [dMin, dMax] = std::minmax_element(list.begin(), list.end());
     if (config.sample.method == "lattice" && *dMax > 1.01 * *dMin)
       throw InputError(fmt::format("config error: sample.grading.file = {}: diameters from {:g} to {:g} m, but "
@@ -222,7 +222,7 @@ std::optional<Simulation> loadInputFiles(const lab::RunConfig& config) {
   }
   if (config.contact.sphericity) {
     const lab::SphericityConfig& sc = *config.contact.sphericity;
-    lab::checkRollingFriction(lab::readSphericityFile(sc.file, "contact.sphericity.file"), sc.c, sc.k, sc.file,
+    lab::checkRollingFriction(sc.distribution, sc.c, sc.k, sc.file,
                               "contact.sphericity.file");
   }
   if (config.sample.packing.empty()) {

@@ -11,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "io/input_file.hpp"
+#include "io/list_files.hpp"
 #include "io/install_paths.hpp"
 #include "io/presets.hpp"
 
@@ -423,6 +424,9 @@ lab::GradingConfig parseGrading(Section& s, const std::string& baseDir, bool mus
     if (!f || !f->is_string()) fail(key + ".file", f ? show(*f) : "(missing)", "a path to a file of diameters [m] is required");
     g.file = resolvePath(f->value<std::string>().value(), baseDir);
     if (mustExist && !pathExists(g.file)) fail(key + ".file", show(*f), notFound(g.file));
+    // Read here, so the laboratory gets the diameters and `check` checks the file (not for resume,
+    // whose grains are in the checkpoint).
+    if (mustExist) g.list = readDiameterList(g.file);
   } else if (g.type == "packing") {
     // The grading of a packing file is its own (recorded so in config.resolved.toml).
     if (!s.raw("packing")) fail(key + ".type", show(*type), "\"packing\" is the grading of sample.packing; give sample.packing");
@@ -771,7 +775,7 @@ void parseStressPath(const toml::node& node, const std::string& baseDir, bool mu
     test.pathSource = path;
     if (!mustExist && !pathExists(path)) return;
     if (!pathExists(path)) fail(key + ".file", show(*file), notFound(path));
-    test.path = lab::readStressPathFile(path, key + ".file");
+    test.path = readStressPathFile(path, key + ".file");
     return;
   }
   if (!points) fail(key, show(node), "needs file = \"path.csv\" (or points with controls)");
@@ -952,6 +956,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     if (!file || !file->is_string()) fail(key + ".file", file ? show(*file) : "(missing)", "a path to a CSV of sphericities is required");
     sc.file = resolvePath(file->value<std::string>().value(), baseDir);
     if (inputFilesMustExist && !pathExists(sc.file)) fail(key + ".file", show(*file), notFound(sc.file));
+    if (inputFilesMustExist) sc.distribution = readSphericityFile(sc.file, key + ".file");  // not for resume
     if (const toml::node* cn = t.get("c")) {
       if (!cn->is_number() || !(numberOf(*cn) > 0.0) || !std::isfinite(numberOf(*cn)) || subnormal(numberOf(*cn)))
         fail(key + ".c", show(*cn), "must be a finite, normal number > 0 (mu_r = c psi^k)");

@@ -14,68 +14,18 @@
 
 namespace grainlab::lab {
 
-namespace {
 
-// A number in a list file: the whole field (an optional '+' aside) must be one, and finite.
-std::optional<double> listNumber(std::string_view field, bool& numeric) {
-  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
-  numeric = !field.empty() && end == field.data() + field.size() &&
-            (ec == std::errc() || ec == std::errc::result_out_of_range);
-  if (!numeric || ec != std::errc() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
-}  // namespace
-
-std::vector<double> readDiameterList(const std::string& path) {
-  const std::string subject = fmt::format("config error: sample.grading.file = {}", io::quotedPath(path));
-  const std::string text = io::readInputFile(path, subject, io::kMaxListFileBytes);
-  std::vector<double> out;
-  std::size_t pos = 0;
-  int lineNo = 0;
-  bool header = false;  // the optional header line is past
-  while (pos < text.size()) {
-    const std::size_t nl = std::min(text.find('\n', pos), text.size());
-    const std::string_view line(text.data() + pos, nl - pos);
-    pos = nl + 1;
-    ++lineNo;
-    std::string_view field = line.substr(0, line.find(','));
-    const auto b = field.find_first_not_of(" \t\r");
-    if (b == std::string_view::npos || field[b] == '#') continue;
-    field = field.substr(b, field.find_last_not_of(" \t\r") - b + 1);
-    bool numeric = false;
-    const std::optional<double> d = listNumber(field, numeric);
-    // The one optional header: the first line that is not blank or a comment, if it has no digit at
-    // all (e.g. "diameter_m"); "0.003abc" is a bad diameter, never a header.
-    // "nan" and "inf" have no digit but are numbers (refused below as non-finite), not headers.
-    auto isNumberWord = [](std::string_view f) {
-      std::string lower;
-      for (char ch : f)
-        if (ch != '+' && ch != '-') lower += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      return lower == "nan" || lower == "inf" || lower == "infinity";
-    };
-    if (out.empty() && !header && field.find_first_of("0123456789") == std::string_view::npos && !isNumberWord(field)) {
-      header = true;
-      continue;
-    }
-    header = true;
-    if (!d || !(*d >= kMinDiameter && *d <= kMaxDiameter))
-      throw InputError(fmt::format("{}: line {}: \"{}\" is not a diameter in [{:g}, {:g}] m", subject, lineNo,
-                                   io::printable(field), kMinDiameter, kMaxDiameter));
-    out.push_back(*d);
-  }
-  if (out.empty()) throw InputError(fmt::format("{}: no diameters found", subject));
-  return out;
-}
 
 std::vector<double> sampleDiameters(const GradingConfig& g, int n, Rng& rng) {
   std::vector<double> d(n);
   if (g.type == "uniform") {
     for (auto& v : d) v = rng.uniform(g.dMin, g.dMax);
   } else if (g.type == "list") {
-    const std::vector<double> list = readDiameterList(g.file);
+    const std::vector<double>& list = g.list;
+    if (list.empty())
+      throw InputError(fmt::format("config error: sample.grading.file = {}: its diameters were not read with the config",
+                                   io::quotedPath(g.file)));
     if (static_cast<int>(list.size()) == n) {
       d = list;
     } else {

@@ -14,12 +14,7 @@ namespace grainlab::lab {
 // sampled exactly by inverting its cumulative distribution.
 std::vector<double> sampleDiameters(const GradingConfig& grading, int n, Rng& rng);
 
-// The diameters [m] of a list file (sample.grading type "list"): one per line, the first field of a
-// CSV row; blank lines and '#' comments skipped; one optional header, the first other line, only if
-// it holds no digit at all ("diameter_m"; "0.003abc" is a bad diameter). Every value must be a
-// diameter in [kMinDiameter, kMaxDiameter]; throws InputError naming the file and line. The file is
-// read within io::kMaxListFileBytes.
-std::vector<double> readDiameterList(const std::string& path);
+// (A list grading's diameters are read with the config: io::readDiameterList, io/list_files.hpp.)
 
 // Characteristic diameters of a set of spheres, by mass (as a sieve analysis would give).
 struct GradingStats {

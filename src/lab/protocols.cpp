@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "core/state_io.hpp"
 #include "lab/measurements.hpp"
+#include "io/input_file.hpp"
 #include "lab/sphericity.hpp"
 
 namespace grainlab::lab {
@@ -225,7 +226,10 @@ std::vector<double> assignRollingFriction(const RunConfig& c, Particles& particl
     return std::vector<double>(n, 1.0);
   }
   const SphericityConfig& sc = *c.contact.sphericity;
-  const SphericityDistribution d = readSphericityFile(sc.file, "contact.sphericity.file");
+  const SphericityDistribution& d = sc.distribution;
+  if (d.values.empty() && d.frequency.empty())
+    throw InputError(fmt::format("config error: contact.sphericity.file = {}: its distribution was not read with the config",
+                                 io::quotedPath(sc.file)));
   // A stream of its own, so that giving grains a sphericity does not change the sample's grading.
   Rng rng(c.sample.seed ^ 0x9e3779b97f4a7c15ull);
   std::vector<double> psi = sampleSphericity(d, n, rng);

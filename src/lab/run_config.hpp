@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/servo_settings.hpp"
+#include "lab/sphericity.hpp"
 #include "lab/stress_path.hpp"
 #include "lab/test_type.hpp"
 
@@ -34,6 +35,7 @@ struct GradingConfig {
   double dMin = 2.0e-3;                           // [m] (uniform)
   double dMax = 8.0e-3;                           // [m] (uniform)
   std::string file;                               // (list) one diameter [m] per line/row
+  std::vector<double> list;                       // (list) the file's diameters [m], read with the config
 
   // The grading of a run from sample.packing: its grains are the packing's.
   static GradingConfig ofPacking() {
@@ -108,6 +110,7 @@ struct SampleConfig {
 
 struct SphericityConfig {
   std::string file;          // CSV: column `sphericity`, or `bin_low,bin_high,frequency`
+  SphericityDistribution distribution;  // the file's contents, read with the config
   double c = 0.1963;         // mu_r = c psi^k ([R])
   double k = 0.0;            // required, no default
   std::string combine = "min";  // "min" | "mean" | "harmonic"

@@ -19,9 +19,7 @@ struct SphericityDistribution {
   bool isHistogram() const { return !frequency.empty(); }
 };
 
-// Reads a CSV with a header: one column `sphericity` (a list), or columns `bin_low,bin_high,frequency`
-// (a histogram). Throws InputError naming `key`, the file and the line for bad content.
-SphericityDistribution readSphericityFile(const std::string& path, const std::string& key);
+// (The distribution is read with the config: io::readSphericityFile, io/list_files.hpp.)
 
 // Draws n sphericities: from a list, uniformly among its values (a bootstrap of the measurement);
 // from a histogram, a bin with probability proportional to its frequency, then uniformly inside.

@@ -35,10 +35,8 @@ std::optional<PathControl> parseControl(std::string_view text);
 // strains in [-kMaxPathStrain, kMaxPathStrain], every value finite.
 std::string checkPathPoint(const PathPoint& point, double previousS);
 
-// Reads a CSV of path points: comment lines start with '#', a header names the columns
-// s, xx, xx_control, yy, yy_control, zz, zz_control (in any order; the controls are "stress" or
-// "strain"), then one point per line. Every defect is an InputError naming `key`, the file, the
-// line and what is allowed.
-std::vector<PathPoint> readStressPathFile(const std::string& path, const std::string& key);
+// (A path file is read with the config: io::readStressPathFile, io/list_files.hpp: comment lines
+// start with '#', a header names the columns s, xx, xx_control, yy, yy_control, zz, zz_control in
+// any order, then one point per line, each checked by checkPathPoint.)
 
 }  // namespace grainlab::lab

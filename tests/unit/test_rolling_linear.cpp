@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "io/list_files.hpp"
 #include "contact/models.hpp"
 #include "core/errors.hpp"
 #include "lab/kinematics.hpp"
@@ -115,7 +116,7 @@ TEST(Sphericity, FileErrorsNameTheProblem) {
   auto expectError = [&](const std::string& content, const std::string& fragment) {
     std::ofstream(path) << content;
     try {
-      lab::readSphericityFile(path, "contact.sphericity.file");
+      io::readSphericityFile(path, "contact.sphericity.file");
       ADD_FAILURE() << "no error for: " << content;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();

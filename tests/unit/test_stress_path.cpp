@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "io/list_files.hpp"
 #include "core/errors.hpp"
 #include "lab/boundary_control.hpp"
 #include "lab/protocol/shear_protocol.hpp"
@@ -175,7 +176,7 @@ std::string writeFile(const std::string& name, const std::string& text) {
 }
 std::string errorOf(const std::string& text) {
   try {
-    lab::readStressPathFile(writeFile("bad", text), "test.path.file");
+    io::readStressPathFile(writeFile("bad", text), "test.path.file");
   } catch (const InputError& e) {
     return e.what();
   }
@@ -184,7 +185,7 @@ std::string errorOf(const std::string& text) {
 }  // namespace
 
 TEST(StressPathFile, ReadsPointsInAnyColumnOrder) {
-  const auto pts = lab::readStressPathFile(
+  const auto pts = io::readStressPathFile(
       writeFile("good", "# a path\nzz,zz_control,s,xx,xx_control,yy,yy_control\n0.01,strain,0.01,1e5,stress,1e5,stress\n"
                         "2e5, stress ,0.02,0,strain,0,strain\n"),
       "test.path.file");
