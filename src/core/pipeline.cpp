@@ -4,8 +4,8 @@
 
 namespace grainlab {
 
-Pipeline::Pipeline(Simulation& sim) : sim_(sim) {
-  const auto& engine = Simulation::engineStages();
+Pipeline::Pipeline(Simulation& sim) : sim_(sim), boundary_(sim.boundary) {
+  const auto& engine = sim.stages();
   for (std::size_t k = 0; k < engine.size(); ++k)  // run by sim_.step()
     stages_.push_back({engine[k].name, {}, Trigger::always(), Place::Engine, k, engine[k].reads, engine[k].writes});
 }
@@ -22,9 +22,9 @@ void Pipeline::addAfter(std::string name, Action action, Trigger trigger) {
 
 void Pipeline::addInside(std::string name, const std::string& afterEngineStage, ParticleAction body, unsigned reads,
                          unsigned writes) {
-  const std::size_t after = Simulation::engineStageIndex(afterEngineStage);
+  const std::size_t after = Simulation::engineStageIndex(boundary_, afterEngineStage);
   // The clock ends the step without a barrier (Simulation::advanceClock): nothing may follow it.
-  if (after + 1 == Simulation::engineStages().size())
+  if (after + 1 == Simulation::engineStages(boundary_).size())
     throw std::invalid_argument("an inner stage cannot follow the engine's last stage, \"" + afterEngineStage + "\"");
   // After the engine stage and any inner stages already placed after it.
   std::size_t at = 0;
@@ -38,6 +38,9 @@ void Pipeline::addInside(std::string name, const std::string& afterEngineStage, 
 }
 
 long Pipeline::run() {
+  // The engine stages listed (and the inner stages placed among them) are this boundary's.
+  if (sim_.boundary != boundary_)
+    throw std::logic_error("Pipeline::run: the simulation's boundary changed since the pipeline was built");
   stopping_ = false;
   steps_ = 0;
   while (!stopping_) {
@@ -84,7 +87,7 @@ std::string Pipeline::describeAccess() const {
       s += ": between steps\n";
       continue;
     }
-    const bool serial = st.place == Place::Engine && Simulation::engineStages()[st.engineIndex].serial;
+    const bool serial = st.place == Place::Engine && Simulation::engineStages(boundary_)[st.engineIndex].serial;
     s += st.place == Place::Engine ? (serial ? ": engine, serial" : ": engine, shared out")
                                    : ": inside the step, shared out by particle";
     s += "; reads " + Simulation::accessNames(st.reads) + "; writes " + Simulation::accessNames(st.writes) + "\n";

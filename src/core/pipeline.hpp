@@ -71,6 +71,7 @@ class Pipeline {
     unsigned reads = 0, writes = 0;
   };
   Simulation& sim_;
+  Boundary boundary_;  // the engine stages listed are this boundary kind's
   std::vector<Stage> stages_;
   std::vector<Simulation::InnerStage> inner_;
   std::size_t firstEngine_ = 0;

@@ -22,25 +22,39 @@
 
 namespace grainlab {
 
-const std::vector<Simulation::EngineStage>& Simulation::engineStages() {
-  // The engine's pipeline, in order: the one place where the step is defined.
-  static const std::vector<EngineStage> stages{
+const std::vector<Simulation::EngineStage>& Simulation::engineStages(Boundary kind) {
+  // The engine's pipeline, in order, per boundary kind: the one place where a step is defined. Each
+  // stage is the boundary's own instance (no boundary branch inside a stage); a backend other than
+  // this CPU one (OpenMP loops over the kernels of core/kernels/) would bring its own lists.
+  static const std::vector<EngineStage> walls{
       {"broad phase", &Simulation::updateBroadPhase, true, kPositions | kBoundary | kContacts,
        kPositions | kContacts},
-      {"contacts", &Simulation::computeContacts, false, kPositions | kVelocities | kRotations | kContacts | kBoundary,
-       kContacts | kEnergy | kBoundary},
-      {"boundary forces", &Simulation::measureBoundary, false, kContacts | kBoundary, kBoundary},
-      {"boundary control", &Simulation::controlBoundary, true, kBoundary, kBoundary | kEnergy},
-      {"integrate", &Simulation::integrate, false,
+      {"contacts", &Simulation::computeContactsFor<false>, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary, kContacts | kEnergy},
+      {"boundary forces", &Simulation::measureWalls, false, kContacts | kBoundary, kBoundary},
+      {"boundary control", &Simulation::controlWallStage, true, kBoundary, kBoundary | kEnergy},
+      {"integrate", &Simulation::integrateFor<false>, false,
        kPositions | kVelocities | kRotations | kContacts | kBoundary,
        kPositions | kVelocities | kRotations | kForces | kEnergy},
       {"clock", &Simulation::advanceClock, true, kClock, kClock},
   };
-  return stages;
+  // In a cell the contact stage also sums the stress and the servo's stiffness: no wall sums.
+  static const std::vector<EngineStage> periodic{
+      {"broad phase", &Simulation::updateBroadPhase, true, kPositions | kBoundary | kContacts,
+       kPositions | kContacts},
+      {"contacts", &Simulation::computeContactsFor<true>, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary, kContacts | kEnergy | kBoundary},
+      {"boundary control", &Simulation::controlCellStage, true, kBoundary, kBoundary | kEnergy},
+      {"integrate", &Simulation::integrateFor<true>, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary,
+       kPositions | kVelocities | kRotations | kForces | kEnergy},
+      {"clock", &Simulation::advanceClock, true, kClock, kClock},
+  };
+  return kind == Boundary::Periodic ? periodic : walls;
 }
 
-std::size_t Simulation::engineStageIndex(const std::string& name) {
-  const auto& stages = engineStages();
+std::size_t Simulation::engineStageIndex(Boundary kind, const std::string& name) {
+  const auto& stages = engineStages(kind);
   for (std::size_t k = 0; k < stages.size(); ++k)
     if (name == stages[k].name) return k;
   throw std::invalid_argument("no engine stage called \"" + name + "\"");
@@ -79,7 +93,7 @@ void Simulation::step(const std::vector<InnerStage>* inner) {
   // changes during the step (the boundary kind, which lists are empty) and on failedStage_ at a
   // stage's start, which every thread reads after the barrier that ended the failing serial part,
   // and which a later failure cannot change for an earlier stage.
-  const std::vector<EngineStage>& stages = engineStages();
+  const std::vector<EngineStage>& stages = engineStages(boundary);
   failedStage_.stage.store(StageFlag::kNone, std::memory_order_relaxed);
   stageError_ = nullptr;
   auto runInner = [&](std::size_t after) {
@@ -278,19 +292,13 @@ void Simulation::sumContactTerms(bool ellipsoids) {
   }
 }
 
-void Simulation::computeContacts() {
-  if (boundary == Boundary::Periodic) computeContactsFor<true>();
-  else computeContactsFor<false>();
-}
-
 void Simulation::gatherParticle(std::size_t i) {
   const kernels::Wrench sum = kernels::gatherParticle(contacts, i);  // core/kernels/gather.hpp
   particles.force[i] = sum.force;
   particles.torque[i] = sum.torque;
 }
 
-void Simulation::measureBoundary() {
-  if (boundary == Boundary::Periodic) return;  // the cell's stress is summed by the contact stage
+void Simulation::measureWalls() {
   // The walls' forces, which their servos need. The walls are shared out across the team (thread g
   // of T takes the walls k with k mod T = g, in one pass over the lists), and each wall sums its own
   // contacts in list order, as one thread would: the same bits for any thread count. The loop's
@@ -334,11 +342,12 @@ void Simulation::sumWallForces(int group, int groups) {
   }
 }
 
-void Simulation::controlBoundary() {
-  serial([&] {
-    if (boundary == Boundary::Periodic) controlCell();
-    else controlWalls();
-  });
+void Simulation::controlWallStage() {
+  serial([&] { controlWalls(); });
+}
+
+void Simulation::controlCellStage() {
+  serial([&] { controlCell(); });
 }
 
 void Simulation::controlWalls() {
@@ -457,11 +466,6 @@ void Simulation::setCellGradient() {
     L(i, j) = L(j, i) = -rate;
   }
   L(0, 2) += cell.shearRate;
-}
-
-void Simulation::integrate() {
-  if (boundary == Boundary::Periodic) integrateFor<true>();
-  else integrateFor<false>();
 }
 
 template <bool Periodic>

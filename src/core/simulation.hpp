@@ -1,10 +1,10 @@
 #pragma once
 // The DEM engine: particles of any supported shape in a box of rigid walls or in a periodic cell.
-// One call of step() runs the engine stages, listed in one place (engineStages()):
+// One call of step() runs the engine stages, listed in one place (engineStages(Boundary)):
 //
 //   broad phase (Verlet list, rebuilt when due) -> contacts (one driver instantiated per pair kind)
-//   -> boundary forces (wall sums / cell stress) -> boundary control (wall servos / cell servo)
-//   -> integrate (per particle: force gather in fixed order + damping + leapfrog) -> clock
+//   -> boundary forces (walls: wall sums; a cell's stress is summed by the contacts) -> boundary control
+//   (wall servos / cell servo) -> integrate (per particle: gather + damping + leapfrog) -> clock
 //
 // Laboratory protocols run the same stages inside a Pipeline (core/pipeline.hpp) with their own
 // drives, recorders and stop conditions around them.
@@ -100,7 +100,7 @@ class Simulation {
   // particles and may write only to items in that range; every thread of the step's team runs it on
   // its static share, so the result does not depend on the thread count. It must not throw.
   struct InnerStage {
-    std::size_t after = 0;  // index in engineStages()
+    std::size_t after = 0;  // index in stages()
     std::function<void(std::size_t begin, std::size_t end)> particles;
   };
   // One step: every engine stage in order, inside one OpenMP parallel region (one fork/join per
@@ -109,7 +109,7 @@ class Simulation {
   // a serial part skips the rest of the step and is rethrown here.
   void step(const std::vector<InnerStage>* inner = nullptr);
 
-  // The engine stages, in the order step() runs them.
+  // The engine stages of a boundary kind, in the order step() runs them (stages() for this one's).
   struct EngineStage {
     const char* name;
     void (Simulation::*run)();
@@ -117,9 +117,10 @@ class Simulation {
     unsigned reads;   // Access bits
     unsigned writes;  // Access bits
   };
-  static const std::vector<EngineStage>& engineStages();
+  static const std::vector<EngineStage>& engineStages(Boundary kind);
+  const std::vector<EngineStage>& stages() const { return engineStages(boundary); }
   // The index of the engine stage called `name` (std::invalid_argument when there is none).
-  static std::size_t engineStageIndex(const std::string& name);
+  static std::size_t engineStageIndex(Boundary kind, const std::string& name);
 
   // Volume enclosed by the boundary [m^3].
   double volume() const { return boundary == Boundary::Periodic ? cell.volume() : box.volume(); }
@@ -135,10 +136,9 @@ class Simulation {
 
  private:
   void updateBroadPhase();
-  void computeContacts();
-  void measureBoundary();
-  void controlBoundary();
-  void integrate();
+  void measureWalls();
+  void controlWallStage();
+  void controlCellStage();
   void advanceClock();
   void gatherParticle(std::size_t i);
   template <bool Periodic>

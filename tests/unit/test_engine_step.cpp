@@ -141,3 +141,32 @@ TEST(EngineStep, InnerStagesRunAfterTheirEngineStageForEveryParticle) {
   EXPECT_THROW(pipeline.addInside("late", "clock", none, 0, 0), std::invalid_argument);
   EXPECT_THROW(pipeline.addInside("nowhere", "collisions", none, 0, 0), std::invalid_argument);
 }
+
+// The engine builds its stage list from the boundary kind: a cell has no wall sums (its stress is
+// summed by the contact stage), and a pipeline refuses to run once the boundary it was built for
+// has changed (its inner stages are placed by index in that list).
+TEST(EngineStep, StageListFollowsTheBoundaryKind) {
+  auto names = [](Boundary kind) {
+    std::string s;
+    for (const auto& st : Simulation::engineStages(kind)) s += (s.empty() ? "" : ", ") + std::string(st.name);
+    return s;
+  };
+  EXPECT_EQ(names(Boundary::Walls), "broad phase, contacts, boundary forces, boundary control, integrate, clock");
+  EXPECT_EQ(names(Boundary::Periodic), "broad phase, contacts, boundary control, integrate, clock");
+  EXPECT_EQ(Simulation::engineStageIndex(Boundary::Periodic, "integrate"), 3u);
+  EXPECT_THROW(Simulation::engineStageIndex(Boundary::Periodic, "boundary forces"), std::invalid_argument);
+  for (Boundary kind : {Boundary::Walls, Boundary::Periodic}) {
+    int serial = 0;
+    for (const auto& st : Simulation::engineStages(kind)) {
+      serial += st.serial;
+      EXPECT_NE(st.writes, 0u) << st.name;
+    }
+    EXPECT_EQ(serial, 3);  // broad phase (prepare/finish), boundary control, clock
+  }
+  omp_set_num_threads(1);
+  Simulation sim = sparseLattice();
+  Pipeline pipeline(sim);
+  pipeline.addAfter("stop", [&] { pipeline.stop(); });
+  sim.boundary = Boundary::Periodic;
+  EXPECT_THROW(pipeline.run(), std::logic_error);
+}
