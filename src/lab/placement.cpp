@@ -58,6 +58,32 @@ bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodi
   return true;
 }
 
+// The grains of a placement, largest first (tryPlace places the large ones while there is room),
+// and their solid volume.
+struct Grains {
+  std::vector<double> radii;
+  double solid = 0.0;  // [m^3]
+  double dMax = 0.0;   // [m]
+};
+Grains largestFirst(std::vector<double> diameters) {
+  std::sort(diameters.begin(), diameters.end(), std::greater<>());
+  Grains g;
+  g.radii.resize(diameters.size());
+  for (std::size_t i = 0; i < diameters.size(); ++i) {
+    g.radii[i] = 0.5 * diameters[i];
+    g.solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
+  }
+  g.dMax = diameters.front();
+  return g;
+}
+
+// Places the grains in a column of the given footprint, raising its height by 5 % until they fit;
+// returns the height.
+double placeInColumn(const std::vector<double>& radii, double width, double height, Rng& rng, std::vector<Vec3>& pos) {
+  while (!tryPlace(radii, Vec3(width, width, height), false, rng, pos)) height *= 1.05;
+  return height;
+}
+
 // Adds the spheres renumbered in cell order (z, y, x) of cells about one large diameter wide, so
 // that neighbours in space are neighbours in memory.
 void addInCellOrder(const std::vector<Vec3>& pos, const std::vector<double>& radii, const Vec3& extent, double density,
@@ -83,15 +109,11 @@ void addInCellOrder(const std::vector<Vec3>& pos, const std::vector<double>& rad
 
 void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim) {
   const bool periodic = sim.boundary == Boundary::Periodic;
-  std::sort(diameters.begin(), diameters.end(), std::greater<>());
-  std::vector<double> radii(diameters.size());
-  double solid = 0.0;
-  for (std::size_t i = 0; i < diameters.size(); ++i) {
-    radii[i] = 0.5 * diameters[i];
-    solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
-  }
+  const Grains g = largestFirst(std::move(diameters));
+  const std::vector<double>& radii = g.radii;
+  const double solid = g.solid;
   double side = std::cbrt(solid * (1.0 + voidRatio));
-  side = std::max(side, 2.0 * diameters.front());
+  side = std::max(side, 2.0 * g.dMax);
   std::vector<Vec3> pos;
   while (!tryPlace(radii, Vec3::Constant(side), periodic, rng, pos)) side *= 1.05;
 
@@ -102,18 +124,14 @@ void placeLoose(std::vector<double> diameters, double density, double voidRatio,
 
 ColumnPlacement placeColumn(std::vector<double> diameters, double density, double voidRatio, double bedVoidRatio,
                             double dropHeight, Rng& rng, Simulation& sim) {
-  std::sort(diameters.begin(), diameters.end(), std::greater<>());
-  std::vector<double> radii(diameters.size());
-  double solid = 0.0;
-  for (std::size_t i = 0; i < diameters.size(); ++i) {
-    radii[i] = 0.5 * diameters[i];
-    solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
-  }
+  const Grains g = largestFirst(std::move(diameters));
+  const std::vector<double>& radii = g.radii;
+  const double solid = g.solid;
   // A square footprint on which the settled bed (at about bedVoidRatio) is roughly a cube.
-  const double width = std::max(std::cbrt(solid * (1.0 + bedVoidRatio)), 2.0 * diameters.front());
-  double height = std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * diameters.front());
+  const double width = std::max(std::cbrt(solid * (1.0 + bedVoidRatio)), 2.0 * g.dMax);
   std::vector<Vec3> pos;
-  while (!tryPlace(radii, Vec3(width, width, height), false, rng, pos)) height *= 1.05;
+  const double height = placeInColumn(radii, width, std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * g.dMax),
+                                      rng, pos);
   for (Vec3& x : pos) x.z() += dropHeight;
   addInCellOrder(pos, radii, Vec3(width, width, height + dropHeight), density, sim);
   sim.box.setBounds(Vec3::Zero(), Vec3(width, width, height + dropHeight));
@@ -126,16 +144,12 @@ ColumnPlacement placeColumn(std::vector<double> diameters, double density, doubl
 
 double appendSlab(std::vector<double> diameters, double density, double voidRatio, double width, double zBottom, Rng& rng,
                   Simulation& sim) {
-  std::sort(diameters.begin(), diameters.end(), std::greater<>());
-  std::vector<double> radii(diameters.size());
-  double solid = 0.0;
-  for (std::size_t i = 0; i < diameters.size(); ++i) {
-    radii[i] = 0.5 * diameters[i];
-    solid += kPi / 6.0 * diameters[i] * diameters[i] * diameters[i];
-  }
-  double height = std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * diameters.front());
+  const Grains g = largestFirst(std::move(diameters));
+  const std::vector<double>& radii = g.radii;
+  const double solid = g.solid;
   std::vector<Vec3> pos;
-  while (!tryPlace(radii, Vec3(width, width, height), false, rng, pos)) height *= 1.05;
+  const double height = placeInColumn(radii, width, std::max(solid * (1.0 + voidRatio) / (width * width), 2.0 * g.dMax),
+                                      rng, pos);
   // Cell order within the slab (its own z from the slab's bottom), then lifted onto the bed.
   addInCellOrder(pos, radii, Vec3(width, width, height), density, sim, true);
   for (std::size_t i = sim.particles.size() - pos.size(); i < sim.particles.size(); ++i) sim.particles.position[i].z() += zBottom;

@@ -44,7 +44,7 @@ CASES = {
     "stress-path-b": ("preset:stress-path-b", ["--set", "sample.n_particles=300", "--set", "test.probe_strain=0"]),
     "stress-path-constant-p": ("preset:stress-path-constant-p",
                                ["--set", "sample.n_particles=300", "--set", "test.probe_strain=0"]),
-    # Tests and laws no preset runs.
+    # Tests, laws and preparations no preset runs.
     "undrained-triaxial": ("preset:quick-triaxial", SHORT + ["--set", 'test.drainage="undrained"']),
     "oedometer": ("preset:quick-triaxial",
                   SHORT + ["--set", 'test.type="oedometer"', "--set", "test.max_axial_stress=3e5",
@@ -53,6 +53,11 @@ CASES = {
                      SHORT + ["--set", 'test.type="simple-shear"', "--set", "test.final_shear_strain=0.01"]),
     "hertz-mindlin": ("preset:quick-triaxial", SHORT + ["--set", 'contact.model="hertz-mindlin"']),
     "gravity": ("preset:quick-triaxial", SHORT + ["--set", "sample.gravity=[0, 0, -98.1]"]),
+    "deposition": ("preset:quick-triaxial", ["--set", "sample.n_particles=100", "--set", 'sample.method="deposition"',
+                                             "--set", "test.final_axial_strain=0.005", "--set", "test.probe_strain=0"]),
+    "under-compaction": ("preset:quick-triaxial",
+                         ["--set", "sample.n_particles=100", "--set", 'sample.method="under-compaction"',
+                          "--set", "test.final_axial_strain=0.005", "--set", "test.probe_strain=0"]),
 }
 
 
