@@ -29,4 +29,18 @@ inline ViscousKick viscousMidpointKick(const Vec3& momentum, const Vec3& force, 
   return k;
 }
 
+// One damped leapfrog kick of a velocity v (or a sphere's angular velocity) under the load f (or
+// torque) with mass m and 1/m (or I and 1/I): [O]'s viscous midpoint kick when viscous > 0, else
+// Cundall's local damping with alpha. Updates v and returns the damping force over the step.
+inline Vec3 dampedKick(Vec3& v, const Vec3& f, double m, double invM, double h, double viscous, double alpha) {
+  if (viscous > 0.0) {
+    const ViscousKick kick = viscousMidpointKick(m * v, f, viscous, h);
+    v = kick.momentum * invM;
+    return kick.dampingForce;
+  }
+  const Vec3 fd = localDamping(f, v, alpha);
+  v += (f + fd) * (h * invM);
+  return fd;
+}
+
 }  // namespace grainlab::kernels

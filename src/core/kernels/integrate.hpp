@@ -92,15 +92,8 @@ inline ParticleWork integrateParticle(const IntegratorView& p, std::size_t i, co
   const Vec3 t = p.torque[i];
   Vec3 fd, td;
   const Vec3 vOld = v[i], wOld = w[i];
-  if (viscous) {
-    // [O] eq. 3.27-3.28: (p_new - p_old)/dt = F - alpha (p_old + p_new)/2, p = m v or I w (L).
-    const ViscousKick kick = viscousMidpointKick(p.mass[i] * v[i], f, s.viscousDamping, h);
-    fd = kick.dampingForce;
-    v[i] = kick.momentum * p.invMass[i];
-  } else {
-    fd = localDamping(f, v[i], alpha);
-    v[i] += (f + fd) * (h * p.invMass[i]);
-  }
+  // [O] eq. 3.27-3.28 (viscous), or Cundall's local damping (core/kernels/damping.hpp).
+  fd = dampedKick(v[i], f, p.mass[i], p.invMass[i], h, s.viscousDamping, alpha);
   if (p.shape[i] == Shape::Ellipsoid) {
     // Distinct principal moments: the rotational leapfrog of core/rigid_rotation.hpp (Euler's
     // equations with the gyroscopic term, second order, angular momentum kept exact; local damping
@@ -114,14 +107,7 @@ inline ParticleWork integrateParticle(const IntegratorView& p, std::size_t i, co
     q[i] = r.step.orientation;
     p.angularMomentum[i] = r.angularMomentum;
   } else {
-    if (viscous) {
-      const ViscousKick kick = viscousMidpointKick(p.inertia[i] * w[i], t, s.viscousDamping, h);
-      td = kick.dampingForce;
-      w[i] = kick.momentum * p.invInertia[i];
-    } else {
-      td = localDamping(t, w[i], alpha);
-      w[i] += (t + td) * (h * p.invInertia[i]);
-    }
+    td = dampedKick(w[i], t, p.inertia[i], p.invInertia[i], h, s.viscousDamping, alpha);
     if (w[i].squaredNorm() > 0.0) {
       // q <- exp(w dt / 2) q with the exponential to first order, renormalised (docs/physics.md §6).
       const Vec3 half = 0.5 * h * w[i];
