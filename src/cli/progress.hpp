@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace grainlab::cli {
 
@@ -25,11 +26,7 @@ class ProgressLine {
     char* end = nullptr;
     const double v = std::strtod(text, &end);
     if (end == text || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > 1e6) {
-      std::string shown(text);
-      if (shown.size() > 40) shown = shown.substr(0, 40) + "...";
-      for (char& c : shown)
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-      throw InputError("environment error: GRAINLAB_PROGRESS_SECONDS = \"" + shown +
+      throw InputError("environment error: GRAINLAB_PROGRESS_SECONDS = \"" + io::printable(text) +
                        "\": allowed: seconds between progress lines in a log, a number in [0, 1e6]");
     }
     return v;
