@@ -12,6 +12,8 @@ PKGS+=(libxxhash-dev python3-xxhash)
 PKGS+=(python3-nlopt python3-distributed)
 # The Python module (pybind11, headers of /usr/bin/python3) and Result.dataframe() (pandas).
 PKGS+=(pybind11-dev python3-dev python3-pandas)
+# Vectorised kernels with run-time dispatch (Google Highway).
+PKGS+=(libhwy-dev)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -436,6 +436,7 @@ py::dict contacts(const Simulation& sim) {
 
 PYBIND11_MODULE(_grainlab, m) {
   m.doc() = "grainlab's compiled core (use the grainlab package)";
+  cli::applySimdEnvironment();  // GRAINLAB_SIMD, as for the program: a bad value fails the import
 
   static py::exception<InputError> configError(m, "ConfigError", PyExc_ValueError);
   static py::exception<SimulationError> simulationError(m, "SimulationError", PyExc_RuntimeError);

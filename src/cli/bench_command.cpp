@@ -10,6 +10,7 @@
 #include <string>
 #include <nlohmann/json.hpp>
 
+#include "core/kernels/integrate_simd.hpp"
 #include "cli/commands.hpp"
 #include "cli/thread_count.hpp"
 #include "core/errors.hpp"
@@ -141,6 +142,7 @@ int runBench(const BenchOptions& opt) {
                    {"seconds", seconds},
                    {"particle_steps_per_s", rate},
                    {"threads", opt.threads},
+                   {"simd_target", kernels::simdTarget()},
                    {"dt", sim.dt},
                    {"peak_rss_bytes", peakRss},
                    {"bytes_per_particle", static_cast<double>(peakRss) / sim.particles.size()},
@@ -149,8 +151,9 @@ int runBench(const BenchOptions& opt) {
   if (opt.json) {
     fmt::print("{}\n", j.dump());
   } else {
-    fmt::print("{}: {} particles, {} contacts, {} steps on {} thread(s): {:.3f} s, {:.3g} particle-steps/s\n",
-               scene, sim.particles.size(), sim.touchingPairs(), opt.steps, opt.threads, seconds, rate);
+    fmt::print("{}: {} particles, {} contacts, {} steps on {} thread(s), {} kernels: {:.3f} s, {:.3g} particle-steps/s\n",
+               scene, sim.particles.size(), sim.touchingPairs(), opt.steps, opt.threads, kernels::simdTarget(), seconds,
+               rate);
   }
   return 0;
 }

@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    cli::applySimdEnvironment();
     if (app.got_subcommand("presets")) {
       for (const auto& p : io::presets()) fmt::print("{:<22} {}\n", p.name, p.description);
       return 0;

@@ -19,6 +19,7 @@
 #include "cli/progress.hpp"
 #include "cli/thread_count.hpp"
 #include "core/errors.hpp"
+#include "core/kernels/integrate_simd.hpp"
 #include "core/state_io.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/config.hpp"
@@ -850,6 +851,7 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       summary["drainage"] = config.test.drainage == lab::Drainage::Undrained ? "undrained" : "drained";
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
+    summary["simd_target"] = kernels::simdTarget();  // GRAINLAB_SIMD; the results do not depend on it
     for (const auto& w : config.warnings) summary["warnings"].push_back(w);
     RunSession session(config, folder, opt.quiet, summary, 0.0, {}, {}, observer);
     lab::Laboratory& lab = session.lab();

@@ -15,6 +15,10 @@
 
 #include <fmt/format.h>
 
+#include "core/errors.hpp"
+#include "core/kernels/integrate_simd.hpp"
+#include "io/input_file.hpp"
+
 namespace grainlab::cli {
 
 namespace {
@@ -115,6 +119,19 @@ ThreadChoice chooseThreads(int requested, bool adapt) {
                                                         "without spinning, which is much faster on busy cores")
                     : "; GRAINLAB_KEEP_THREADS=1 keeps the requested count");
   return c;
+}
+
+void applySimdEnvironment() {
+  const char* text = std::getenv(kernels::SimdChoice::kEnvironment);
+  if (text == nullptr) return;
+  try {
+    kernels::selectSimdTarget(text);
+  } catch (const std::invalid_argument&) {
+    std::string allowed;
+    for (const std::string& n : kernels::simdTargetNames()) allowed += (allowed.empty() ? "" : ", ") + n;
+    throw InputError(std::string("environment error: ") + kernels::SimdChoice::kEnvironment + " = \"" +
+                     io::printable(text) + "\" is not a vector target of this program and CPU; allowed: " + allowed);
+  }
 }
 
 }  // namespace grainlab::cli

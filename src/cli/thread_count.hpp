@@ -40,4 +40,9 @@ bool forkedAfterOpenMPTeams();
 // The warning chooseThreads gives in such a child (for the Python module's warnings.warn).
 std::string forkedThreadsWarning(int requested);
 
+// Applies the environment variable GRAINLAB_SIMD (core/kernels/integrate_simd.hpp): which
+// vector target the kernels use ("best" when unset; results are bit-identical for every target).
+// An InputError names the value and the names allowed on this machine.
+void applySimdEnvironment();
+
 }  // namespace grainlab::cli

@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "core/kernels/gather.hpp"
 #include "core/kernels/integrate.hpp"
+#include "core/kernels/integrate_simd.hpp"
 #include "core/parallel.hpp"
 #include "core/state_io.hpp"
 #include "core/rigid_rotation.hpp"
@@ -492,12 +493,30 @@ void Simulation::integrateFor() {
   // Per chunk: the IntegrateSum terms; the sums were cut for the particles by the contact stage.
   ChunkedSums& sums = integrateSums_;
 
+  // Spheres under local damping take the vectorised kernel (core/kernels/integrate_simd.hpp), a
+  // chunk at a time after the chunk's gather: the same bits as the per-particle kernel.
+  const bool vectorised = kernels::simdEnabled() && viscousDamping <= 0.0;
+  const Shape* shape = particles.shape.data();
+
 #pragma omp for schedule(static)
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
     double work = 0.0, gravityWork = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
-    for (std::size_t i = sums.begin(chunk); i < sums.end(chunk); ++i) {
-      gatherParticle(i);
-      const kernels::ParticleWork pw = kernels::integrateParticle<Periodic>(view, i, stepParams);
+    const std::size_t first = sums.begin(chunk), last = sums.end(chunk);
+    kernels::ParticleWork chunkWork[ChunkedSums::kChunk];
+    const bool batch =
+        vectorised && std::all_of(shape + first, shape + last, [](Shape s) { return s == Shape::Sphere; });
+    if (batch) {
+      for (std::size_t i = first; i < last; ++i) gatherParticle(i);
+      kernels::integrateSpheres(view, first, last, stepParams, Periodic, chunkWork);
+    }
+    for (std::size_t i = first; i < last; ++i) {
+      kernels::ParticleWork pw;
+      if (batch) {
+        pw = chunkWork[i - first];
+      } else {
+        gatherParticle(i);
+        pw = kernels::integrateParticle<Periodic>(view, i, stepParams);
+      }
       work += pw.damping;
       if (stepParams.gravityOn) gravityWork += pw.gravity;
       if (!xBuild.empty()) {

@@ -61,11 +61,15 @@ CASES = {
 }
 
 
-def run_case(binary, name, workdir):
+def run_case(binary, name, workdir, simd=None):
+    """SHA-256 of the case's timeseries.csv; simd: a GRAINLAB_SIMD value (None: the environment's)."""
     config, sets = CASES[name]
-    out = os.path.join(workdir, name)
+    out = os.path.join(workdir, name if simd is None else f"{name}-{simd}")
+    env = dict(os.environ)
+    if simd is not None:
+        env["GRAINLAB_SIMD"] = simd
     proc = subprocess.run([binary, "run", config, "--out", out, "--quiet", "--threads", "1", *sets],
-                          capture_output=True, text=True, timeout=900)
+                          capture_output=True, text=True, timeout=900, env=env)
     if proc.returncode != 0:
         raise RuntimeError(f"{name}: grainlab exited {proc.returncode}: {proc.stderr.strip()}")
     with open(os.path.join(out, "timeseries.csv"), "rb") as f:

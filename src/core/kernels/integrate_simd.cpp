@@ -1,0 +1,219 @@
+// The sphere integrator over Highway vectors (see integrate_simd.hpp). Highway compiles this file
+// once per target (foreach_target.h re-includes it); HWY_EXPORT / HWY_DYNAMIC_DISPATCH pick the
+// target at run time.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/kernels/integrate_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "core/kernels/integrate_simd.hpp"
+
+// The kernel reads the particle arrays as flat arrays of doubles.
+static_assert(sizeof(grainlab::Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
+static_assert(sizeof(grainlab::Quat) == 4 * sizeof(double), "Quat must be four packed doubles (x, y, z, w)");
+
+HWY_BEFORE_NAMESPACE();
+namespace grainlab::kernels::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Processes whole vectors of particles from `begin`; returns where it stopped (the caller does the
+// rest with the scalar kernel). Each line below is the scalar kernel's expression, operation for
+// operation in Eigen's order (integrate.hpp; the comments quote it).
+template <bool Periodic>
+std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                     ParticleWork* work) {
+  const hn::ScalableTag<double> d;
+  using V = hn::Vec<decltype(d)>;
+  const std::size_t lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), minusOne = hn::Set(d, -1.0), half = hn::Set(d, 0.5);
+  const V h = hn::Set(d, s.h), halfH = hn::Set(d, 0.5 * s.h), minusAlpha = hn::Set(d, -s.localDamping);
+  const V g0 = hn::Set(d, s.gravity[0]), g1 = hn::Set(d, s.gravity[1]), g2 = hn::Set(d, s.gravity[2]);
+  V m00, m01, m02, m10, m11, m12, m20, m21, m22;
+  if constexpr (Periodic) {
+    const Mat3& M = s.flowStep;
+    m00 = hn::Set(d, M(0, 0)), m01 = hn::Set(d, M(0, 1)), m02 = hn::Set(d, M(0, 2));
+    m10 = hn::Set(d, M(1, 0)), m11 = hn::Set(d, M(1, 1)), m12 = hn::Set(d, M(1, 2));
+    m20 = hn::Set(d, M(2, 0)), m21 = hn::Set(d, M(2, 1)), m22 = hn::Set(d, M(2, 2));
+  }
+  // Eigen's sign(): +1, -1, or 0 where the value is 0.
+  auto sign = [&](V a) { return hn::IfThenElse(hn::Gt(a, zero), one, hn::IfThenElse(hn::Lt(a, zero), minusOne, zero)); };
+  // Eigen's 3-vector dot product: (a0 b0 + a1 b1) + a2 b2.
+  auto dot = [](V a0, V a1, V a2, V b0, V b1, V b2) {
+    return hn::Add(hn::Add(hn::Mul(a0, b0), hn::Mul(a1, b1)), hn::Mul(a2, b2));
+  };
+  double* const x = p.position->data();
+  double* const v = p.velocity->data();
+  double* const w = p.angularVelocity->data();
+  double* const q = p.orientation->coeffs().data();  // x, y, z, w per particle
+  const double* const force = p.force->data();
+  const double* const torque = p.torque->data();
+  HWY_ALIGN double damping[hn::MaxLanes(d)];
+  HWY_ALIGN double gravityWork[hn::MaxLanes(d)];
+  std::size_t i = begin;
+  for (; i + lanes <= end; i += lanes) {
+    V x0, x1, x2, v0, v1, v2, w0, w1, w2, f0, f1, f2, t0, t1, t2;
+    hn::LoadInterleaved3(d, x + 3 * i, x0, x1, x2);
+    hn::LoadInterleaved3(d, v + 3 * i, v0, v1, v2);
+    hn::LoadInterleaved3(d, w + 3 * i, w0, w1, w2);
+    hn::LoadInterleaved3(d, force + 3 * i, f0, f1, f2);
+    hn::LoadInterleaved3(d, torque + 3 * i, t0, t1, t2);
+    const V m = hn::LoadU(d, p.mass + i), invM = hn::LoadU(d, p.invMass + i);
+    const V invI = hn::LoadU(d, p.invInertia + i);
+    // f = force + m g
+    f0 = hn::Add(f0, hn::Mul(m, g0));
+    f1 = hn::Add(f1, hn::Mul(m, g1));
+    f2 = hn::Add(f2, hn::Mul(m, g2));
+    // fd = ((-alpha) |f|) sign(v); v += (f + fd) (h / m)
+    const V fd0 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f0)), sign(v0));
+    const V fd1 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f1)), sign(v1));
+    const V fd2 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f2)), sign(v2));
+    const V hm = hn::Mul(h, invM);
+    const V vn0 = hn::Add(v0, hn::Mul(hn::Add(f0, fd0), hm));
+    const V vn1 = hn::Add(v1, hn::Mul(hn::Add(f1, fd1), hm));
+    const V vn2 = hn::Add(v2, hn::Mul(hn::Add(f2, fd2), hm));
+    // the same for the spin with the torque and 1/I
+    const V td0 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t0)), sign(w0));
+    const V td1 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t1)), sign(w1));
+    const V td2 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t2)), sign(w2));
+    const V hi = hn::Mul(h, invI);
+    const V wn0 = hn::Add(w0, hn::Mul(hn::Add(t0, td0), hi));
+    const V wn1 = hn::Add(w1, hn::Mul(hn::Add(t1, td1), hi));
+    const V wn2 = hn::Add(w2, hn::Mul(hn::Add(t2, td2), hi));
+    // q <- Quat(1, (0.5 h) w) * q, renormalised, where |w|^2 > 0 (Eigen's SSE quaternion product)
+    const auto spinning = hn::Gt(hn::Add(hn::Add(hn::Mul(wn0, wn0), hn::Mul(wn1, wn1)), hn::Mul(wn2, wn2)), zero);
+    if (!hn::AllFalse(d, spinning)) {
+      V bx, by, bz, bw;
+      hn::LoadInterleaved4(d, q + 4 * i, bx, by, bz, bw);
+      const V ax = hn::Mul(halfH, wn0), ay = hn::Mul(halfH, wn1), az = hn::Mul(halfH, wn2), aw = one;
+      const V rx = hn::Sub(hn::Add(hn::Mul(aw, bx), hn::Mul(ay, bz)), hn::Sub(hn::Mul(az, by), hn::Mul(ax, bw)));
+      const V ry = hn::Add(hn::Add(hn::Mul(aw, by), hn::Mul(ay, bw)), hn::Sub(hn::Mul(az, bx), hn::Mul(ax, bz)));
+      const V rz = hn::Add(hn::Sub(hn::Mul(aw, bz), hn::Mul(ay, bx)), hn::Add(hn::Mul(az, bw), hn::Mul(ax, by)));
+      const V rw = hn::Sub(hn::Sub(hn::Mul(aw, bw), hn::Mul(ay, by)), hn::Add(hn::Mul(az, bz), hn::Mul(ax, bx)));
+      // eps = |qn|^2 - 1 with Eigen's two-lane sum (x^2 + z^2) + (y^2 + w^2)
+      const V eps = hn::Sub(hn::Add(hn::Add(hn::Mul(rx, rx), hn::Mul(rz, rz)), hn::Add(hn::Mul(ry, ry), hn::Mul(rw, rw))), one);
+      const V series = hn::Add(hn::Sub(one, hn::Mul(half, eps)), hn::Mul(hn::Mul(hn::Set(d, 0.375), eps), eps));
+      const V root = hn::Div(one, hn::Sqrt(hn::Add(one, eps)));
+      const V scale = hn::IfThenElse(hn::Lt(hn::Abs(eps), hn::Set(d, 1e-6)), series, root);
+      bx = hn::IfThenElse(spinning, hn::Mul(rx, scale), bx);
+      by = hn::IfThenElse(spinning, hn::Mul(ry, scale), by);
+      bz = hn::IfThenElse(spinning, hn::Mul(rz, scale), bz);
+      bw = hn::IfThenElse(spinning, hn::Mul(rw, scale), bw);
+      hn::StoreInterleaved4(bx, by, bz, bw, d, q + 4 * i);
+    }
+    // damping work: h (fd . (0.5 (vOld + v)) + td . (0.5 (wOld + w)))
+    const V dv = dot(fd0, fd1, fd2, hn::Mul(half, hn::Add(v0, vn0)), hn::Mul(half, hn::Add(v1, vn1)),
+                     hn::Mul(half, hn::Add(v2, vn2)));
+    const V dw = dot(td0, td1, td2, hn::Mul(half, hn::Add(w0, wn0)), hn::Mul(half, hn::Add(w1, wn1)),
+                     hn::Mul(half, hn::Add(w2, wn2)));
+    hn::Store(hn::Mul(h, hn::Add(dv, dw)), d, damping);
+    // x += v h (periodic: x += v h + M x, the product with the old x in Eigen's order: rows 0 and 1
+    // in one SSE2 register, (M0 x0 + M1 x1) + M2 x2; row 2 by its scalar unroller, M0 x0 + (M1 x1 + M2 x2))
+    if constexpr (Periodic) {
+      const V mx0 = hn::Add(hn::Add(hn::Mul(m00, x0), hn::Mul(m01, x1)), hn::Mul(m02, x2));
+      const V mx1 = hn::Add(hn::Add(hn::Mul(m10, x0), hn::Mul(m11, x1)), hn::Mul(m12, x2));
+      const V mx2 = hn::Add(hn::Mul(m20, x0), hn::Add(hn::Mul(m21, x1), hn::Mul(m22, x2)));
+      x0 = hn::Add(x0, hn::Add(hn::Mul(vn0, h), mx0));
+      x1 = hn::Add(x1, hn::Add(hn::Mul(vn1, h), mx1));
+      x2 = hn::Add(x2, hn::Add(hn::Mul(vn2, h), mx2));
+    } else {
+      x0 = hn::Add(x0, hn::Mul(vn0, h));
+      x1 = hn::Add(x1, hn::Mul(vn1, h));
+      x2 = hn::Add(x2, hn::Mul(vn2, h));
+    }
+    hn::StoreInterleaved3(x0, x1, x2, d, x + 3 * i);
+    hn::StoreInterleaved3(vn0, vn1, vn2, d, v + 3 * i);
+    hn::StoreInterleaved3(wn0, wn1, wn2, d, w + 3 * i);
+    // gravity's work: (m (g . v)) h
+    if (s.gravityOn) hn::Store(hn::Mul(hn::Mul(m, dot(g0, g1, g2, vn0, vn1, vn2)), h), d, gravityWork);
+    for (std::size_t k = 0; k < lanes; ++k) {
+      work[i - begin + k].damping = damping[k];
+      work[i - begin + k].gravity = s.gravityOn ? gravityWork[k] : 0.0;
+    }
+  }
+  return i;
+}
+
+std::size_t IntegrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                             bool periodic, ParticleWork* work) {
+  return periodic ? SpheresT<true>(p, begin, end, s, work) : SpheresT<false>(p, begin, end, s, work);
+}
+
+const char* TargetOfThisCode() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace grainlab::kernels::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include <stdexcept>
+
+namespace grainlab::kernels {
+
+HWY_EXPORT(IntegrateSpheres);
+HWY_EXPORT(TargetOfThisCode);
+
+namespace {
+
+struct NamedTarget {
+  const char* name;
+  std::int64_t target;
+};
+// Best first. Highway calls AVX-512 (F, BW, DQ, VL) "AVX3".
+constexpr NamedTarget kTargets[] = {
+    {"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}, {"ssse3", HWY_SSSE3}, {"emu128", HWY_EMU128}};
+
+// The targets compiled in and supported by this CPU, read once before any selection narrows them.
+std::int64_t availableTargets() {
+  static const std::int64_t available = hwy::SupportedTargets() & HWY_TARGETS;
+  return available;
+}
+
+bool gScalar = false;
+
+}  // namespace
+
+std::vector<std::string> simdTargetNames() {
+  std::vector<std::string> names{"best", "scalar"};
+  for (const NamedTarget& t : kTargets)
+    if (availableTargets() & t.target) names.emplace_back(t.name);
+  return names;
+}
+
+void selectSimdTarget(const std::string& name) {
+  const std::int64_t available = availableTargets();
+  if (name == "best" || name == "scalar") {
+    hwy::SetSupportedTargetsForTest(0);
+    gScalar = name == "scalar";
+    return;
+  }
+  for (const NamedTarget& t : kTargets) {
+    if (name != t.name) continue;
+    if (!(available & t.target)) break;
+    hwy::SetSupportedTargetsForTest(t.target);
+    gScalar = false;
+    return;
+  }
+  std::string allowed;
+  for (const std::string& n : simdTargetNames()) allowed += (allowed.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("SIMD target \"" + name + "\" is not one this program and CPU have; allowed: " + allowed);
+}
+
+std::string simdTarget() {
+  if (gScalar) return "scalar";
+  std::string name = HWY_DYNAMIC_DISPATCH(TargetOfThisCode)();
+  for (char& c : name) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  return name == "avx3" ? "avx512" : name;
+}
+
+bool simdEnabled() { return !gScalar; }
+
+void integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                      bool periodic, ParticleWork* work) {
+  std::size_t i = begin;
+  if (!gScalar) i = HWY_DYNAMIC_DISPATCH(IntegrateSpheres)(p, begin, end, s, periodic, work);
+  // The rest (fewer than one vector) with the scalar kernel: the same bits.
+  for (; i < end; ++i)
+    work[i - begin] = periodic ? integrateParticle<true>(p, i, s) : integrateParticle<false>(p, i, s);
+}
+
+}  // namespace grainlab::kernels
+#endif  // HWY_ONCE

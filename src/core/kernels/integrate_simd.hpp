@@ -1,0 +1,47 @@
+#pragma once
+// The sphere integrator vectorised over particles (issue 25, part 2): several particles per
+// instruction through Google Highway (Debian libhwy-dev), with run-time dispatch, so that one
+// portable x86-64 binary uses the widest vectors the CPU has (SSSE3, SSE4, AVX2 or AVX-512, and
+// Highway's EMU128, a portable emulation of 128-bit vectors in scalar code).
+//
+// Every target computes, lane by lane, the same IEEE operations in the same order as the scalar
+// kernel kernels::integrateParticle (core/kernels/integrate.hpp) with Eigen's evaluation order:
+// the results are bit-identical between the targets and with the scalar kernel (no contraction
+// into fused multiply-adds: the project compiles with -ffp-contract=off, docs/architecture.md,
+// "Floating point"). tests/unit/test_integrate_simd.cpp checks it on every target this CPU has.
+//
+// It covers the engine's common case: spheres under local (Cundall) damping, with or without
+// gravity, walls or a periodic cell. Ellipsoids and [O]'s viscous damping take the scalar kernel.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/kernels/integrate.hpp"
+
+namespace grainlab::kernels {
+
+// Which kernel the integrator uses: the scalar per-particle kernel, or a Highway target.
+// "best" (the default) is the widest target this CPU supports.
+struct SimdChoice {
+  static constexpr const char* kEnvironment = "GRAINLAB_SIMD";
+};
+
+// Names a user may give (GRAINLAB_SIMD): "best", "scalar", and the Highway targets compiled in
+// and supported by this CPU ("emu128", "ssse3", "sse4", "avx2", "avx512"), best first.
+std::vector<std::string> simdTargetNames();
+// Selects the kernel by name; std::invalid_argument (naming the value and what is allowed) when
+// the name is unknown or the CPU lacks the target. Not thread-safe: call before stepping.
+void selectSimdTarget(const std::string& name);
+// The kernel in use: "scalar" or the Highway target's name (e.g. "avx2").
+std::string simdTarget();
+// Whether a vectorised target is selected (false: "scalar").
+bool simdEnabled();
+
+// Advances particles [begin, end) by one step. Precondition: every one is a sphere and
+// s.viscousDamping == 0. work[k] receives particle begin + k's ParticleWork (the caller sums them
+// in particle order, as it sums the scalar kernel's). Periodic: the position follows the cell's
+// homogeneous flow too (s.flowStep).
+void integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                      bool periodic, ParticleWork* work);
+
+}  // namespace grainlab::kernels
