@@ -471,8 +471,9 @@ void Simulation::setCellGradient() {
 
 template <bool Periodic>
 void Simulation::integrateFor() {
-  // The per-particle kernel (core/kernels/integrate.hpp) over a view of the arrays; this loop only
-  // shares the particles out, gathers each one's contacts and keeps the chunk sums.
+  // The per-particle kernel (core/kernels/integrate.hpp) over a view of the arrays, or its
+  // vectorised twin; this loop only shares the particles out, gathers each one's contacts and
+  // keeps the chunk sums (the kernels' work terms in particle order, the checks of each chunk).
   const kernels::IntegratorView view = kernels::IntegratorView::of(particles);
   kernels::IntegratorStep stepParams;
   stepParams.h = dt;
@@ -484,9 +485,6 @@ void Simulation::integrateFor() {
   // M = exp(L h) - I that advanced H; the rebuild test measures displacements from where that flow
   // has carried each particle's build position (F x_build, F = H H_build^-1).
   stepParams.flowStep = cell.flowStep(dt);
-  const auto& x = particles.position;
-  const auto& v = particles.velocity;
-  const auto& w = particles.angularVelocity;
   const auto& xBuild = broadPhase.positionsAtBuild();
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   const Mat3 deformation = Periodic ? broadPhase.cellDeformation(cell) : Mat3::Identity();
@@ -497,43 +495,37 @@ void Simulation::integrateFor() {
   // chunk at a time after the chunk's gather: the same bits as the per-particle kernel.
   const bool vectorised = kernels::simdEnabled() && viscousDamping <= 0.0;
   const Shape* shape = particles.shape.data();
+  kernels::StepChecks checks;
+  checks.positionsAtBuild = xBuild.empty() ? nullptr : xBuild.data();
+  checks.deformation = deformation;
+  checks.radius = particles.radius.data();
+  checks.lower = lo;
+  checks.upper = hi;
 
 #pragma omp for schedule(static)
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
-    double work = 0.0, gravityWork = 0.0, maxDisp2 = 0.0, badParticle = std::numeric_limits<double>::infinity();
+    double work = 0.0, gravityWork = 0.0;
     const std::size_t first = sums.begin(chunk), last = sums.end(chunk);
     kernels::ParticleWork chunkWork[ChunkedSums::kChunk];
-    const bool batch =
-        vectorised && std::all_of(shape + first, shape + last, [](Shape s) { return s == Shape::Sphere; });
-    if (batch) {
+    kernels::ChecksResult r;
+    if (vectorised && std::all_of(shape + first, shape + last, [](Shape s) { return s == Shape::Sphere; })) {
       for (std::size_t i = first; i < last; ++i) gatherParticle(i);
-      kernels::integrateSpheres(view, first, last, stepParams, Periodic, chunkWork);
+      r = kernels::integrateSpheres(view, first, last, stepParams, Periodic, chunkWork, checks);
+    } else {
+      for (std::size_t i = first; i < last; ++i) {
+        gatherParticle(i);
+        chunkWork[i - first] = kernels::integrateParticle<Periodic>(view, i, stepParams);
+        kernels::checkParticle<Periodic>(view, i, checks, r);
+      }
     }
     for (std::size_t i = first; i < last; ++i) {
-      kernels::ParticleWork pw;
-      if (batch) {
-        pw = chunkWork[i - first];
-      } else {
-        gatherParticle(i);
-        pw = kernels::integrateParticle<Periodic>(view, i, stepParams);
-      }
-      work += pw.damping;
-      if (stepParams.gravityOn) gravityWork += pw.gravity;
-      if (!xBuild.empty()) {
-        if constexpr (Periodic) maxDisp2 = std::max(maxDisp2, (x[i] - deformation * xBuild[i]).squaredNorm());
-        else maxDisp2 = std::max(maxDisp2, (x[i] - xBuild[i]).squaredNorm());
-      }
-      const bool finite = x[i].allFinite() && v[i].allFinite() && w[i].allFinite();
-      bool inside = true;
-      if constexpr (!Periodic) {
-        const double r = particles.radius[i];
-        inside = ((x[i] - lo).array() > -r).all() && ((hi - x[i]).array() > -r).all();
-      }
-      if ((!finite || !inside) && !(badParticle < static_cast<double>(i))) badParticle = static_cast<double>(i);
+      work += chunkWork[i - first].damping;
+      if (stepParams.gravityOn) gravityWork += chunkWork[i - first].gravity;
     }
     sums.at(chunk, kDampingWork) = work;
-    sums.at(chunk, kDisp2) = maxDisp2;
-    sums.at(chunk, kBadParticle) = badParticle;
+    sums.at(chunk, kDisp2) = r.maxDisplacement2;
+    sums.at(chunk, kBadParticle) = r.firstBad == kernels::ChecksResult::kNoParticle ? std::numeric_limits<double>::infinity()
+                                                                                    : static_cast<double>(r.firstBad);
     sums.at(chunk, kGravityWork) = gravityWork;
   }
   serial([&] { finishIntegration<Periodic>(deformation); });

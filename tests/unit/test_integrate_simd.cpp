@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <ostream>
 #include <random>
 #include <vector>
 
@@ -69,6 +70,9 @@ struct Case {
   bool gravity;
   double alpha;
 };
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << (c.periodic ? "cell" : "walls") << (c.gravity ? ", gravity" : "") << ", alpha " << c.alpha;
+}
 
 class SimdTargets : public ::testing::TestWithParam<Case> {
  protected:
@@ -93,24 +97,55 @@ TEST_P(SimdTargets, EveryTargetMatchesTheScalarKernelBitForBit) {
   const std::size_t n = 37;
   Particles reference = randomSpheres(n, 11);
   const Particles start = reference;
+  // The checks: build positions near the particles, a deformation since the build (cell), a box
+  // that three particles have left (walls).
+  std::vector<Vec3> build(n);
+  {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1e-4, 1e-4);
+    for (std::size_t i = 0; i < n; ++i) build[i] = start.position[i] + Vec3(u(rng), u(rng), u(rng));
+  }
+  kernels::StepChecks checks;
+  checks.positionsAtBuild = build.data();
+  if (c.periodic) checks.deformation << 1.01, 0.02, -0.03, 0.004, 0.99, 0.05, -0.06, 0.007, 1.02;
+  checks.radius = start.radius.data();
+  checks.lower = Vec3(-1e-2, -1e-2, -1e-2);
+  checks.upper = Vec3(1e-2, 1e-2, 1e-2);
+  for (std::size_t i : {17u, 21u, 34u}) reference.position[i][i % 3] = 2e-2;  // outside (walls)
+  const Particles start2 = reference;
   std::vector<kernels::ParticleWork> referenceWork(n);
+  kernels::ChecksResult referenceChecks[2];
   {
     const kernels::IntegratorView view = kernels::IntegratorView::of(reference);
-    for (std::size_t i = 0; i < n; ++i)
-      referenceWork[i] = c.periodic ? kernels::integrateParticle<true>(view, i, s)
-                                    : kernels::integrateParticle<false>(view, i, s);
+    for (std::size_t i = 0; i < n; ++i) {
+      kernels::ChecksResult& r = referenceChecks[i < 13 ? 0 : 1];
+      if (c.periodic) {
+        referenceWork[i] = kernels::integrateParticle<true>(view, i, s);
+        kernels::checkParticle<true>(view, i, checks, r);
+      } else {
+        referenceWork[i] = kernels::integrateParticle<false>(view, i, s);
+        kernels::checkParticle<false>(view, i, checks, r);
+      }
+    }
   }
+  EXPECT_EQ(referenceChecks[1].firstBad, c.periodic ? kernels::ChecksResult::kNoParticle : 17u);
   const std::vector<std::string> targets = kernels::simdTargetNames();
   ASSERT_GE(targets.size(), 3u) << "best, scalar and at least one vector target";
   for (const std::string& target : targets) {
     kernels::selectSimdTarget(target);
-    Particles p = start;
+    Particles p = start2;
     std::vector<kernels::ParticleWork> work(n);
     const kernels::IntegratorView view = kernels::IntegratorView::of(p);
     // Two calls: one from 0, one from an offset that is not a multiple of any vector width.
-    kernels::integrateSpheres(view, 0, 13, s, c.periodic, work.data());
-    kernels::integrateSpheres(view, 13, n, s, c.periodic, work.data() + 13);
-    expectIdentical(reference, p, referenceWork, work, "target " + kernels::simdTarget());
+    const kernels::ChecksResult r0 = kernels::integrateSpheres(view, 0, 13, s, c.periodic, work.data(), checks);
+    const kernels::ChecksResult r1 = kernels::integrateSpheres(view, 13, n, s, c.periodic, work.data() + 13, checks);
+    const std::string what = "target " + kernels::simdTarget();
+    expectIdentical(reference, p, referenceWork, work, what);
+    EXPECT_TRUE(sameBits(&r0.maxDisplacement2, &referenceChecks[0].maxDisplacement2, sizeof(double))) << what;
+    EXPECT_TRUE(sameBits(&r1.maxDisplacement2, &referenceChecks[1].maxDisplacement2, sizeof(double))) << what;
+    EXPECT_GT(r1.maxDisplacement2, 0.0) << what;
+    EXPECT_EQ(r0.firstBad, referenceChecks[0].firstBad) << what;
+    EXPECT_EQ(r1.firstBad, referenceChecks[1].firstBad) << what;
   }
 }
 

@@ -21,7 +21,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 // operation in Eigen's order (integrate.hpp; the comments quote it).
 template <bool Periodic>
 std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
-                     ParticleWork* work) {
+                     ParticleWork* work, const StepChecks& c, ChecksResult& result) {
   const hn::ScalableTag<double> d;
   using V = hn::Vec<decltype(d)>;
   const std::size_t lanes = hn::Lanes(d);
@@ -35,6 +35,20 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
     m10 = hn::Set(d, M(1, 0)), m11 = hn::Set(d, M(1, 1)), m12 = hn::Set(d, M(1, 2));
     m20 = hn::Set(d, M(2, 0)), m21 = hn::Set(d, M(2, 1)), m22 = hn::Set(d, M(2, 2));
   }
+  // The checks (StepChecks): the build's deformation F (periodic), the box (walls).
+  const bool measure = c.positionsAtBuild != nullptr;
+  const double* const xBuild = measure ? c.positionsAtBuild->data() : nullptr;
+  V f00, f01, f02, f10, f11, f12, f20, f21, f22, lo0, lo1, lo2, up0, up1, up2;
+  if constexpr (Periodic) {
+    const Mat3& F = c.deformation;
+    f00 = hn::Set(d, F(0, 0)), f01 = hn::Set(d, F(0, 1)), f02 = hn::Set(d, F(0, 2));
+    f10 = hn::Set(d, F(1, 0)), f11 = hn::Set(d, F(1, 1)), f12 = hn::Set(d, F(1, 2));
+    f20 = hn::Set(d, F(2, 0)), f21 = hn::Set(d, F(2, 1)), f22 = hn::Set(d, F(2, 2));
+  } else {
+    lo0 = hn::Set(d, c.lower[0]), lo1 = hn::Set(d, c.lower[1]), lo2 = hn::Set(d, c.lower[2]);
+    up0 = hn::Set(d, c.upper[0]), up1 = hn::Set(d, c.upper[1]), up2 = hn::Set(d, c.upper[2]);
+  }
+  V maxDisp2 = zero;
   // Eigen's sign(): +1, -1, or 0 where the value is 0.
   auto sign = [&](V a) { return hn::IfThenElse(hn::Gt(a, zero), one, hn::IfThenElse(hn::Lt(a, zero), minusOne, zero)); };
   // Eigen's 3-vector dot product: (a0 b0 + a1 b1) + a2 b2.
@@ -129,13 +143,44 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
       work[i - begin + k].damping = damping[k];
       work[i - begin + k].gravity = s.gravityOn ? gravityWork[k] : 0.0;
     }
+    // checks: |x - x_build|^2 (cell: |x - F x_build|^2, F x_build in Eigen's row order as M x
+    // above), then finite state and (walls) inside the box: x - lo > -r and hi - x > -r
+    if (measure) {
+      V b0, b1, b2;
+      hn::LoadInterleaved3(d, xBuild + 3 * i, b0, b1, b2);
+      if constexpr (Periodic) {
+        const V fb0 = hn::Add(hn::Add(hn::Mul(f00, b0), hn::Mul(f01, b1)), hn::Mul(f02, b2));
+        const V fb1 = hn::Add(hn::Add(hn::Mul(f10, b0), hn::Mul(f11, b1)), hn::Mul(f12, b2));
+        const V fb2 = hn::Add(hn::Mul(f20, b0), hn::Add(hn::Mul(f21, b1), hn::Mul(f22, b2)));
+        b0 = fb0, b1 = fb1, b2 = fb2;
+      }
+      const V d0 = hn::Sub(x0, b0), d1 = hn::Sub(x1, b1), d2 = hn::Sub(x2, b2);
+      maxDisp2 = hn::Max(maxDisp2, dot(d0, d1, d2, d0, d1, d2));
+    }
+    auto ok = hn::And(hn::And(hn::And(hn::IsFinite(x0), hn::IsFinite(x1)), hn::And(hn::IsFinite(x2), hn::IsFinite(vn0))),
+                      hn::And(hn::And(hn::IsFinite(vn1), hn::IsFinite(vn2)),
+                              hn::And(hn::IsFinite(wn0), hn::And(hn::IsFinite(wn1), hn::IsFinite(wn2)))));
+    if constexpr (!Periodic) {
+      const V negR = hn::Neg(hn::LoadU(d, c.radius + i));
+      ok = hn::And(ok, hn::And(hn::And(hn::Gt(hn::Sub(x0, lo0), negR), hn::Gt(hn::Sub(x1, lo1), negR)),
+                               hn::And(hn::Gt(hn::Sub(x2, lo2), negR), hn::Gt(hn::Sub(up0, x0), negR))));
+      ok = hn::And(ok, hn::And(hn::Gt(hn::Sub(up1, x1), negR), hn::Gt(hn::Sub(up2, x2), negR)));
+    }
+    const auto bad = hn::Not(ok);
+    if (!hn::AllFalse(d, bad) && result.firstBad == ChecksResult::kNoParticle)
+      result.firstBad = i + static_cast<std::size_t>(hn::FindFirstTrue(d, bad));
   }
+  // The largest lane (max is exact whatever the order).
+  HWY_ALIGN double lanesMax[hn::MaxLanes(d)];
+  hn::Store(maxDisp2, d, lanesMax);
+  for (std::size_t k = 0; k < lanes; ++k) result.maxDisplacement2 = std::max(result.maxDisplacement2, lanesMax[k]);
   return i;
 }
 
 std::size_t IntegrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
-                             bool periodic, ParticleWork* work) {
-  return periodic ? SpheresT<true>(p, begin, end, s, work) : SpheresT<false>(p, begin, end, s, work);
+                             bool periodic, ParticleWork* work, const StepChecks& c, ChecksResult& result) {
+  return periodic ? SpheresT<true>(p, begin, end, s, work, c, result)
+                  : SpheresT<false>(p, begin, end, s, work, c, result);
 }
 
 const char* TargetOfThisCode() { return hwy::TargetName(HWY_TARGET); }
@@ -206,13 +251,22 @@ std::string simdTarget() {
 
 bool simdEnabled() { return !gScalar; }
 
-void integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
-                      bool periodic, ParticleWork* work) {
+ChecksResult integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                              bool periodic, ParticleWork* work, const StepChecks& c) {
+  ChecksResult result;
   std::size_t i = begin;
-  if (!gScalar) i = HWY_DYNAMIC_DISPATCH(IntegrateSpheres)(p, begin, end, s, periodic, work);
+  if (!gScalar) i = HWY_DYNAMIC_DISPATCH(IntegrateSpheres)(p, begin, end, s, periodic, work, c, result);
   // The rest (fewer than one vector) with the scalar kernel: the same bits.
-  for (; i < end; ++i)
-    work[i - begin] = periodic ? integrateParticle<true>(p, i, s) : integrateParticle<false>(p, i, s);
+  for (; i < end; ++i) {
+    if (periodic) {
+      work[i - begin] = integrateParticle<true>(p, i, s);
+      checkParticle<true>(p, i, c, result);
+    } else {
+      work[i - begin] = integrateParticle<false>(p, i, s);
+      checkParticle<false>(p, i, c, result);
+    }
+  }
+  return result;
 }
 
 }  // namespace grainlab::kernels

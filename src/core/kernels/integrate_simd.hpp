@@ -12,6 +12,7 @@
 //
 // It covers the engine's common case: spheres under local (Cundall) damping, with or without
 // gravity, walls or a periodic cell. Ellipsoids and [O]'s viscous damping take the scalar kernel.
+#include <algorithm>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -37,11 +38,45 @@ std::string simdTarget();
 // Whether a vectorised target is selected (false: "scalar").
 bool simdEnabled();
 
+// The checks the integrate stage makes on every particle after its step, done by the kernel while
+// the particle is in registers: the largest squared displacement since the broad phase's build
+// (|x - x_build|^2, in a cell |x - F x_build|^2), and the first particle whose state is not finite
+// or (walls) that left the box.
+struct StepChecks {
+  const Vec3* positionsAtBuild = nullptr;  // nullptr: no build yet (no displacement measured)
+  Mat3 deformation = Mat3::Identity();     // periodic: F = H H_build^-1
+  const double* radius = nullptr;          // walls: the particles' radii
+  Vec3 lower = Vec3::Zero(), upper = Vec3::Zero();  // walls: the box's corners
+};
+struct ChecksResult {
+  double maxDisplacement2 = 0.0;       // the largest |dx|^2 of the range (0 without a build)
+  std::size_t firstBad = kNoParticle;  // the lowest index of a bad particle, or kNoParticle
+  static constexpr std::size_t kNoParticle = ~std::size_t{0};
+};
+
 // Advances particles [begin, end) by one step. Precondition: every one is a sphere and
 // s.viscousDamping == 0. work[k] receives particle begin + k's ParticleWork (the caller sums them
 // in particle order, as it sums the scalar kernel's). Periodic: the position follows the cell's
-// homogeneous flow too (s.flowStep).
-void integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
-                      bool periodic, ParticleWork* work);
+// homogeneous flow too (s.flowStep). Returns the checks of `c` over the range.
+ChecksResult integrateSpheres(const IntegratorView& p, std::size_t begin, std::size_t end, const IntegratorStep& s,
+                              bool periodic, ParticleWork* work, const StepChecks& c = {});
+
+// The same checks for one particle after its step, as the scalar loop makes them (integrate.hpp's
+// kernel leaves them to its caller); folded into `r`.
+template <bool Periodic>
+inline void checkParticle(const IntegratorView& p, std::size_t i, const StepChecks& c, ChecksResult& r) {
+  const Vec3& x = p.position[i];
+  if (c.positionsAtBuild != nullptr) {
+    if constexpr (Periodic) r.maxDisplacement2 = std::max(r.maxDisplacement2, (x - c.deformation * c.positionsAtBuild[i]).squaredNorm());
+    else r.maxDisplacement2 = std::max(r.maxDisplacement2, (x - c.positionsAtBuild[i]).squaredNorm());
+  }
+  const bool finite = x.allFinite() && p.velocity[i].allFinite() && p.angularVelocity[i].allFinite();
+  bool inside = true;
+  if constexpr (!Periodic) {
+    const double rad = c.radius[i];
+    inside = ((x - c.lower).array() > -rad).all() && ((c.upper - x).array() > -rad).all();
+  }
+  if ((!finite || !inside) && i < r.firstBad) r.firstBad = i;
+}
 
 }  // namespace grainlab::kernels
