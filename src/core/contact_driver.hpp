@@ -9,8 +9,11 @@
 // stored per contact: for spheres they are a handful of multiplications and one division, cheaper
 // than reading 48 stored bytes per contact per step, and they follow a stiffness change (the
 // preparation's stiffness ramp) without a pass over the contacts (bench/NOTES.md has the measurement).
+#include <type_traits>
+
 #include "contact/models.hpp"
 #include "core/contact_list.hpp"
+#include "core/kernels/contact_simd.hpp"
 #include "core/parallel.hpp"
 #include "core/particles.hpp"
 #include "core/periodic_cell.hpp"
@@ -260,6 +263,113 @@ struct KindKernel<EllipsoidPlane, Periodic> : WallKernelBase<EllipsoidPlane, tru
   }
 };
 
+// A candidate found apart: a contact that was touching opens, and what its shear and moment
+// springs still hold is released with the history (the model keeps no memory of it), so it is
+// booked as dissipated, slip and rolling (added to slip and roll: the energy balance stays
+// closed); its history and result slots are cleared. Returns false when there was nothing to do (a
+// pair that was apart and still is keeps its zero slots, so it is skipped without a write).
+template <class Kernel, class List>
+GRAINLAB_ALWAYS_INLINE bool releaseApart(const ContactContext& ctx, List& list, std::size_t c, bool writeAll,
+                                         double& slip, double& roll) {
+  using Kind = typename List::KindType;
+  typename Kind::History& h = list.history[c];
+  if (!h.touching && !writeAll) return false;
+  if (h.touching) {
+    contact::PairParams p = Kernel::params(ctx, list, c);
+    contact::SphereContactModel::resolve(p, h.overlap);  // Hertz–Mindlin: the springs' last stiffness
+    if (p.ks > 0.0) slip += 0.5 * h.shearForce.squaredNorm() / p.ks;
+    if (p.kr > 0.0) roll += 0.5 * h.moment.squaredNorm() / p.kr;
+  }
+  h = typename Kind::History{};  // (an ellipsoid pair's lambda restarts cold: its solve is cheap)
+  list.force[c].setZero();
+  list.torqueA[c].setZero();
+  if constexpr (!Kind::kPlane) list.torqueB[c].setZero();
+  return true;
+}
+
+// Sphere pairs on the walls' side with the [W] law, vectorised (core/kernels/contact_simd.hpp):
+// per chunk, the apart test and the release of opened contacts here, the touching contacts
+// gathered into tiles for the vector kernel and scattered back. Each contact's dissipation is kept
+// and the chunk's sums are added in contact order afterwards, as the scalar loop adds them: the
+// same bits.
+inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& ctx, ChunkedSums& sums,
+                                bool writeAll) {
+  using Kernel = KindKernel<SphereSphere, false>;
+  using Tile = kernels::SphereLawTile;
+  const kernels::SphereLawConstants constants{ctx.model.young, ctx.model.poisson,     ctx.model.beta,
+                                              ctx.model.eta,   ctx.model.tanFriction, ctx.dt};
+  const Particles& P = ctx.particles;
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
+    const std::size_t first = sums.begin(chunk), last = sums.end(chunk);
+    double slipOf[ChunkedSums::kChunk], rollOf[ChunkedSums::kChunk];
+    Tile tile;
+    std::uint32_t slot[Tile::kSize];
+    std::size_t n = 0;
+    auto flush = [&] {
+      // Pad to whole vectors with lane 0 (computed, not used).
+      const std::size_t padded = (n + 7) / 8 * 8;
+      for (std::size_t j = n; j < padded; ++j) {
+        for (int k = 0; k < 3; ++k) {
+          tile.branch[k][j] = tile.branch[k][0];
+          tile.va[k][j] = tile.va[k][0], tile.vb[k][j] = tile.vb[k][0];
+          tile.wa[k][j] = tile.wa[k][0], tile.wb[k][j] = tile.wb[k][0];
+          tile.shear[k][j] = tile.shear[k][0], tile.moment[k][j] = tile.moment[k][0];
+          tile.prevNormal[k][j] = tile.prevNormal[k][0];
+        }
+        tile.radiusA[j] = tile.radiusA[0], tile.radiusB[j] = tile.radiusB[0], tile.fresh[j] = tile.fresh[0];
+      }
+      kernels::sphereLawTile(constants, tile, padded);
+      for (std::size_t j = 0; j < n; ++j) {
+        const std::uint32_t c = slot[j];
+        contact::ContactHistory& h = list.history[c];
+        list.force[c] = Vec3(tile.force[0][j], tile.force[1][j], tile.force[2][j]);
+        list.torqueA[c] = Vec3(tile.torqueA[0][j], tile.torqueA[1][j], tile.torqueA[2][j]);
+        list.torqueB[c] = Vec3(tile.torqueB[0][j], tile.torqueB[1][j], tile.torqueB[2][j]);
+        h.shearForce = Vec3(tile.shear[0][j], tile.shear[1][j], tile.shear[2][j]);
+        h.moment = Vec3(tile.moment[0][j], tile.moment[1][j], tile.moment[2][j]);
+        h.prevNormal = Vec3(tile.prevNormal[0][j], tile.prevNormal[1][j], tile.prevNormal[2][j]);
+        slipOf[c - first] = tile.slip[j];
+        rollOf[c - first] = tile.roll[j];
+      }
+      n = 0;
+    };
+    for (std::size_t c = first; c < last; ++c) {
+      slipOf[c - first] = 0.0;
+      rollOf[c - first] = 0.0;
+      contact::ContactHistory& h = list.history[c];
+      const std::uint32_t a = list.a[c], b = list.b[c];
+      const Vec3 branch = pairBranch<false>(ctx, list, c);
+      const double dist2 = branch.squaredNorm();
+      const double reach = P.radius[a] + P.radius[b];
+      if (dist2 >= reach * reach) {
+        releaseApart<Kernel>(ctx, list, c, writeAll, slipOf[c - first], rollOf[c - first]);
+        continue;
+      }
+      tile.fresh[n] = h.touching ? 0.0 : 1.0;
+      h.touching = true;
+      for (int k = 0; k < 3; ++k) {
+        tile.branch[k][n] = branch[k];
+        tile.va[k][n] = P.velocity[a][k], tile.vb[k][n] = P.velocity[b][k];
+        tile.wa[k][n] = P.angularVelocity[a][k], tile.wb[k][n] = P.angularVelocity[b][k];
+        tile.shear[k][n] = h.shearForce[k], tile.moment[k][n] = h.moment[k], tile.prevNormal[k][n] = h.prevNormal[k];
+      }
+      tile.radiusA[n] = P.radius[a], tile.radiusB[n] = P.radius[b];
+      slot[n++] = static_cast<std::uint32_t>(c);
+      if (n == Tile::kSize) flush();
+    }
+    if (n > 0) flush();
+    double slip = 0.0, roll = 0.0;
+    for (std::size_t c = first; c < last; ++c) {
+      slip += slipOf[c - first];
+      roll += rollOf[c - first];
+    }
+    sums.at(chunk, kSlip) = slip;
+    sums.at(chunk, kRoll) = roll;
+    sums.at(chunk, kViscous) = 0.0;
+  }
+}
+
 }  // namespace detail
 
 // Evaluates every contact of `list`; call from every thread of an OpenMP parallel region (the loop
@@ -268,6 +378,10 @@ struct KindKernel<EllipsoidPlane, Periodic> : WallKernelBase<EllipsoidPlane, tru
 template <class Kind, bool Periodic>
 void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, ChunkedSums& sums, bool writeAll) {
   using Kernel = detail::KindKernel<Kind, Periodic>;
+  if constexpr (std::is_same_v<Kind, SphereSphere> && !Periodic) {
+    // The same branch on every thread (the model does not change during a step).
+    if (kernels::sphereLawVectorised(ctx.model)) return detail::evaluateSphereTiles(list, ctx, sums, writeAll);
+  }
   // Chunks are scheduled dynamically: only touching pairs run the contact law.
 #pragma omp for schedule(dynamic, 1) nowait
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
@@ -279,21 +393,7 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
       geometry::ContactGeometry g;
       Vec3 branch;
       if (!Kernel::evaluate(ctx, list, c, h, g, branch)) {
-        // A pair that was apart and still is keeps its zero slots, so it is skipped without a write.
-        if (!h.touching && !writeAll) continue;
-        if (h.touching) {
-          // The contact opens: what its shear and moment springs still hold is released with the
-          // history (the model keeps no memory of it), so it is booked as dissipated, slip and
-          // rolling, and the energy balance stays closed.
-          contact::PairParams p = Kernel::params(ctx, list, c);
-          contact::SphereContactModel::resolve(p, h.overlap);  // Hertz–Mindlin: the springs' last stiffness
-          if (p.ks > 0.0) slip += 0.5 * h.shearForce.squaredNorm() / p.ks;
-          if (p.kr > 0.0) roll += 0.5 * h.moment.squaredNorm() / p.kr;
-        }
-        h = typename Kind::History{};  // (an ellipsoid pair's lambda restarts cold: its solve is cheap)
-        list.force[c].setZero();
-        list.torqueA[c].setZero();
-        if constexpr (!Kind::kPlane) list.torqueB[c].setZero();
+        detail::releaseApart<Kernel>(ctx, list, c, writeAll, slip, roll);
         continue;
       }
       if (!h.touching) {
