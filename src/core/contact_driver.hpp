@@ -287,22 +287,43 @@ GRAINLAB_ALWAYS_INLINE bool releaseApart(const ContactContext& ctx, List& list, 
   return true;
 }
 
-// Sphere pairs on the walls' side with the [W] law, vectorised (core/kernels/contact_simd.hpp):
+// A touching pair's terms of the cell's Love–Weber stress (f l^T) and of the servo's affine
+// stiffnesses, added to the chunk's sums.
+GRAINLAB_ALWAYS_INLINE void addCellTerms(Mat3& stress, Vec3& stiffness, Vec3& shearStiffness, const Vec3& force,
+                                         const Vec3& branch, const Vec3& normal, double kn, double ks) {
+  stress += force * branch.transpose();
+  const Vec3 n2 = normal.cwiseProduct(normal);
+  const double l2 = branch.squaredNorm();
+  stiffness += l2 * n2.cwiseProduct(kn * n2 + ks * (Vec3::Ones() - n2));
+  // Pure shear e in the (i, j) plane: l2 (2 kn ni^2 nj^2 + ks ((ni^2 + nj^2)/2 - 2 ni^2 nj^2)).
+  for (int k = 0; k < 3; ++k) {
+    const int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+    const double ninj = n2[i] * n2[j];
+    shearStiffness[k] += l2 * (2.0 * kn * ninj + ks * (0.5 * (n2[i] + n2[j]) - 2.0 * ninj));
+  }
+}
+
+// Sphere pairs with the [W] law, vectorised (core/kernels/contact_simd.hpp):
 // per chunk, the apart test and the release of opened contacts here, the touching contacts
 // gathered into tiles for the vector kernel and scattered back. Each contact's dissipation is kept
 // and the chunk's sums are added in contact order afterwards, as the scalar loop adds them: the
 // same bits.
-inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& ctx, ChunkedSums& sums,
-                                bool writeAll) {
-  using Kernel = KindKernel<SphereSphere, false>;
+template <bool Periodic>
+void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& ctx, ChunkedSums& sums,
+                         bool writeAll) {
+  using Kernel = KindKernel<SphereSphere, Periodic>;
   using Tile = kernels::SphereLawTile;
-  const kernels::SphereLawConstants constants{ctx.model.young, ctx.model.poisson,     ctx.model.beta,
-                                              ctx.model.eta,   ctx.model.tanFriction, ctx.dt};
+  kernels::SphereLawConstants constants{ctx.model.young, ctx.model.poisson,     ctx.model.beta,
+                                        ctx.model.eta,   ctx.model.tanFriction, ctx.dt};
+  constants.periodic = Periodic;
+  if constexpr (Periodic) constants.velocityGradient = ctx.cell.velocityGradient;
   const Particles& P = ctx.particles;
 #pragma omp for schedule(dynamic, 1) nowait
   for (std::size_t chunk = 0; chunk < sums.chunks(); ++chunk) {
     const std::size_t first = sums.begin(chunk), last = sums.end(chunk);
     double slipOf[ChunkedSums::kChunk], rollOf[ChunkedSums::kChunk];
+    Mat3 stress = Mat3::Zero();
+    Vec3 stiffness = Vec3::Zero(), shearStiffness = Vec3::Zero();
     Tile tile;
     std::uint32_t slot[Tile::kSize];
     std::size_t n = 0;
@@ -331,6 +352,12 @@ inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactCo
         h.prevNormal = Vec3(tile.prevNormal[0][j], tile.prevNormal[1][j], tile.prevNormal[2][j]);
         slipOf[c - first] = tile.slip[j];
         rollOf[c - first] = tile.roll[j];
+        if constexpr (Periodic) {
+          // in contact order, as the scalar loop adds them
+          const contact::PairParams p = Kernel::params(ctx, list, c);
+          addCellTerms(stress, stiffness, shearStiffness, list.force[c],
+                       Vec3(tile.branch[0][j], tile.branch[1][j], tile.branch[2][j]), h.prevNormal, p.kn, p.ks);
+        }
       }
       n = 0;
     };
@@ -339,7 +366,7 @@ inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactCo
       rollOf[c - first] = 0.0;
       contact::ContactHistory& h = list.history[c];
       const std::uint32_t a = list.a[c], b = list.b[c];
-      const Vec3 branch = pairBranch<false>(ctx, list, c);
+      const Vec3 branch = pairBranch<Periodic>(ctx, list, c);
       const double dist2 = branch.squaredNorm();
       const double reach = P.radius[a] + P.radius[b];
       if (dist2 >= reach * reach) {
@@ -367,6 +394,11 @@ inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactCo
     sums.at(chunk, kSlip) = slip;
     sums.at(chunk, kRoll) = roll;
     sums.at(chunk, kViscous) = 0.0;
+    if constexpr (Periodic) {
+      for (int i = 0; i < 9; ++i) sums.at(chunk, kStress0 + i) = stress(i % 3, i / 3);
+      for (int i = 0; i < 3; ++i) sums.at(chunk, kStiffness0 + i) = stiffness[i];
+      for (int i = 0; i < 3; ++i) sums.at(chunk, kShearStiffness0 + i) = shearStiffness[i];
+    }
   }
 }
 
@@ -378,9 +410,9 @@ inline void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactCo
 template <class Kind, bool Periodic>
 void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, ChunkedSums& sums, bool writeAll) {
   using Kernel = detail::KindKernel<Kind, Periodic>;
-  if constexpr (std::is_same_v<Kind, SphereSphere> && !Periodic) {
+  if constexpr (std::is_same_v<Kind, SphereSphere>) {
     // The same branch on every thread (the model does not change during a step).
-    if (kernels::sphereLawVectorised(ctx.model)) return detail::evaluateSphereTiles(list, ctx, sums, writeAll);
+    if (kernels::sphereLawVectorised(ctx.model)) return detail::evaluateSphereTiles<Periodic>(list, ctx, sums, writeAll);
   }
   // Chunks are scheduled dynamically: only touching pairs run the contact law.
 #pragma omp for schedule(dynamic, 1) nowait
@@ -421,18 +453,8 @@ void evaluateContacts(ContactList<Kind>& list, const ContactContext& ctx, Chunke
       Kernel::store(list, c, g, res);
       slip += res.slipDissipation;
       roll += res.rollDissipation;
-      if constexpr (Periodic && !Kind::kPlane) {
-        stress += res.force * branch.transpose();
-        const Vec3 n2 = g.normal.cwiseProduct(g.normal);
-        const double l2 = branch.squaredNorm();
-        stiffness += l2 * n2.cwiseProduct(p.kn * n2 + p.ks * (Vec3::Ones() - n2));
-        // Pure shear e in the (i, j) plane: l2 (2 kn ni^2 nj^2 + ks ((ni^2 + nj^2)/2 - 2 ni^2 nj^2)).
-        for (int k = 0; k < 3; ++k) {
-          const int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
-          const double ninj = n2[i] * n2[j];
-          shearStiffness[k] += l2 * (2.0 * p.kn * ninj + p.ks * (0.5 * (n2[i] + n2[j]) - 2.0 * ninj));
-        }
-      }
+      if constexpr (Periodic && !Kind::kPlane)
+        detail::addCellTerms(stress, stiffness, shearStiffness, res.force, branch, g.normal, p.kn, p.ks);
     }
     sums.at(chunk, kSlip) = slip;
     sums.at(chunk, kRoll) = roll;

@@ -38,9 +38,24 @@ Simulation jumbledScene() {
   return sim;
 }
 
-std::string stateAfter(const std::string& target, int steps, Simulation* out = nullptr) {
-  kernels::selectSimdTarget(target);
+// The same grains in a periodic cell sheared at a prescribed velocity gradient (image pairs, the
+// flow term L l of the relative velocity, the cell's stress and stiffness sums).
+Simulation jumbledCell() {
   Simulation sim = jumbledScene();
+  sim.boundary = Boundary::Periodic;
+  sim.cell.setBox(Vec3::Constant(9e-3));
+  sim.cell.prescribedGradient = true;
+  // Large enough that L l dominates the relative velocity, so that the order of its sums shows.
+  sim.cell.velocityGradient << -2.0, 0.3, 5.0, 0.1, 1.0, -0.2, 0.4, 0.05, 1.0;
+  sim.cell.velocityGradient *= 500.0;
+  sim.initialise();
+  sim.dt = 0.2 * sim.criticalTimeStep();
+  return sim;
+}
+
+std::string stateAfter(const std::string& target, int steps, Simulation* out = nullptr, bool cell = false) {
+  kernels::selectSimdTarget(target);
+  Simulation sim = cell ? jumbledCell() : jumbledScene();
   for (int s = 0; s < steps; ++s) sim.step();
   // The particles, every contact list (history and result slots) and the energy ledger, as the
   // checkpoint writes them (not the whole saveState: it also holds structs whose padding bytes are
@@ -51,6 +66,13 @@ std::string stateAfter(const std::string& target, int steps, Simulation* out = n
   const EnergyLedger& e = sim.energy;
   for (double term : {e.slip, e.rolling, e.damping, e.boundaryWork, e.gravityWork})
     bytes.write(reinterpret_cast<const char*>(&term), sizeof term);
+  if (cell) {
+    const Mat3 stress = sim.cell.stress, h = sim.cell.h;
+    bytes.write(reinterpret_cast<const char*>(stress.data()), sizeof(double) * 9);
+    bytes.write(reinterpret_cast<const char*>(h.data()), sizeof(double) * 9);
+    bytes.write(reinterpret_cast<const char*>(sim.cell.stiffness.data()), sizeof(double) * 3);
+    bytes.write(reinterpret_cast<const char*>(sim.cell.shearStiffness.data()), sizeof(double) * 3);
+  }
   if (out) *out = sim;
   kernels::selectSimdTarget("best");
   return bytes.str();
@@ -66,6 +88,22 @@ TEST(ContactSimd, EveryTargetGivesTheScalarPathsState) {
   for (const std::string& target : kernels::simdTargetNames()) {
     if (target == "scalar") continue;
     EXPECT_TRUE(stateAfter(target, 400) == scalar) << "target " << target << ": the state differs from the scalar path's";
+  }
+}
+
+TEST(ContactSimd, EveryTargetGivesTheScalarPathsStateInACell) {
+  Simulation reference;
+  const std::string scalar = stateAfter("scalar", 300, &reference, true);
+  EXPECT_GT(reference.energy.slip, 0.0);
+  EXPECT_GT(reference.touchingPairs(), 100u);
+  std::size_t images = 0;
+  for (std::size_t c = 0; c < reference.contacts.sphereSphere.size(); ++c)
+    images += reference.contacts.sphereSphere.shift[c] != ImageShift::kZero && reference.contacts.sphereSphere.history[c].touching;
+  EXPECT_GT(images, 5u) << "touching pairs across the cell's faces";
+  EXPECT_GT(reference.cell.stress.norm(), 0.0);
+  for (const std::string& target : kernels::simdTargetNames()) {
+    if (target == "scalar") continue;
+    EXPECT_TRUE(stateAfter(target, 300, nullptr, true) == scalar) << "target " << target << ": the state differs";
   }
 }
 

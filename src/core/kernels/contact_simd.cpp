@@ -21,6 +21,10 @@ void SphereLawTileImpl(const SphereLawConstants& kc, SphereLawTile& t, std::size
   const V twoYoung = hn::Set(d, 2.0 * kc.young), poisson = hn::Set(d, kc.poisson), beta = hn::Set(d, kc.beta);
   const V etaHalf = hn::Set(d, kc.eta * 0.5), tanF = hn::Set(d, kc.tanFriction), dt = hn::Set(d, kc.dt);
   const V tiny = hn::Set(d, 1e-12);
+  const Mat3& L = kc.velocityGradient;
+  const V l00 = hn::Set(d, L(0, 0)), l01 = hn::Set(d, L(0, 1)), l02 = hn::Set(d, L(0, 2));
+  const V l10 = hn::Set(d, L(1, 0)), l11 = hn::Set(d, L(1, 1)), l12 = hn::Set(d, L(1, 2));
+  const V l20 = hn::Set(d, L(2, 0)), l21 = hn::Set(d, L(2, 1)), l22 = hn::Set(d, L(2, 2));
   struct V3 {
     V x, y, z;
   };
@@ -94,7 +98,14 @@ void SphereLawTileImpl(const SphereLawConstants& kc, SphereLawTile& t, std::size
     // pairKinematics: vrel = (vb + wb x branchB) - (va + wa x branchA), spin = wb - wa,
     // meanSpinNormal = 0.5 ((wa + wb) . N)
     const V3 va = load3(t.va, i), vb = load3(t.vb, i), wa = load3(t.wa, i), wb = load3(t.wb, i);
-    const V3 vrel = sub(add(vb, cross(wb, branchB)), add(va, cross(wa, branchA)));
+    V3 vrel = sub(add(vb, cross(wb, branchB)), add(va, cross(wa, branchA)));
+    if (kc.periodic) {
+      // += L l, Eigen's row order: rows 0 and 1 (L0 l0 + L1 l1) + L2 l2, row 2 L0 l0 + (L1 l1 + L2 l2)
+      const V3 flow{hn::Add(hn::Add(hn::Mul(l00, branch.x), hn::Mul(l01, branch.y)), hn::Mul(l02, branch.z)),
+                    hn::Add(hn::Add(hn::Mul(l10, branch.x), hn::Mul(l11, branch.y)), hn::Mul(l12, branch.z)),
+                    hn::Add(hn::Mul(l20, branch.x), hn::Add(hn::Mul(l21, branch.y), hn::Mul(l22, branch.z)))};
+      vrel = add(vrel, flow);
+    }
     const V3 spin = sub(wb, wa);
     const V meanSpinNormal = hn::Mul(half, dot(add(wa, wb), normal));
     // applyLaw: Fn = (U > 0 ? Kn U : 0) N, fn = Kn U

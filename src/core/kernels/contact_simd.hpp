@@ -11,10 +11,9 @@
 // Eigen's order, so results are bit-identical to the scalar path on every target
 // (tests/unit/test_contact_simd.cpp).
 //
-// Covered: sphere pairs on walls' side of the engine (no periodic image terms), the linear law,
-// Kozicki–Donzé with [W]'s moment limit, beta > 0, poisson > 0. Everything else (Hertz–Mindlin, the
-// linear rolling law of [R], YADE's separate limits, a constant Kn, a cell, ellipsoids) takes the
-// scalar path.
+// Covered: sphere pairs, walls or a periodic cell, the linear law, Kozicki–Donzé with [W]'s moment
+// limit, beta > 0, poisson > 0. Everything else (Hertz–Mindlin, the linear rolling law of [R],
+// YADE's separate limits, a constant Kn, ellipsoids) takes the scalar path.
 #include <cstddef>
 
 #include "contact/models.hpp"
@@ -37,9 +36,12 @@ struct SphereLawTile {
   alignas(64) double slip[kSize], roll[kSize];
 };
 
-// The law's constants for the whole run.
+// The law's constants for the step.
 struct SphereLawConstants {
   double young, poisson, beta, eta, tanFriction, dt;
+  // A periodic cell: the relative velocity includes the homogeneous flow across the branch, L l.
+  bool periodic = false;
+  Mat3 velocityGradient = Mat3::Zero();
 };
 
 // Whether the vectorised law applies to this model (see the top of this file) and a vector target
