@@ -266,14 +266,7 @@ struct SphereContactModel {
   }
 };
 
-// Forced inline into the contact loops: called out of line, its result struct went through the
-// stack and was read back with wider loads than it was written with (store-forwarding stalls were
-// the hottest samples of computeContacts in the profile).
-#if defined(__GNUC__)
-#define GRAINLAB_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define GRAINLAB_ALWAYS_INLINE inline
-#endif
+// GRAINLAB_ALWAYS_INLINE: core/types.hpp.
 
 // The tangential and moment slots shared by the laws: the carried shear force and moment are
 // turned with the contact frame (and, when Rescale, multiplied by `scale`: Hertz–Mindlin's

@@ -30,12 +30,12 @@ struct FrameRotation {
   double w;
   Vec3 u;
   double invNorm2;  // 1 / |q|^2
-  Vec3 operator*(const Vec3& v) const {
+  GRAINLAB_ALWAYS_INLINE Vec3 operator*(const Vec3& v) const {
     return ((w * w - u.squaredNorm()) * v + (2.0 * u.dot(v)) * u + (2.0 * w) * u.cross(v)) * invNorm2;
   }
 };
 
-inline FrameRotation contactFrameRotation(const Vec3& prevNormal, const Vec3& normal, double twistAngle) {
+GRAINLAB_ALWAYS_INLINE FrameRotation contactFrameRotation(const Vec3& prevNormal, const Vec3& normal, double twistAngle) {
   double tw = 1.0 + prevNormal.dot(normal);
   Vec3 tu = prevNormal.cross(normal);
   if (tw <= 1e-12) {  // normal reversed in one step: no defined tilt; carry nothing but the twist
@@ -59,7 +59,7 @@ struct SlipResult {
 // `carriedShear` is the previous Fs already carried into the current contact frame, `dXs` the
 // tangential displacement increment of B relative to A. Any normal component left by round-off is
 // removed so Fs stays in the tangent plane.
-inline SlipResult tangentialCoulomb(const Vec3& carriedShear, double ks, const Vec3& dXs,
+GRAINLAB_ALWAYS_INLINE SlipResult tangentialCoulomb(const Vec3& carriedShear, double ks, const Vec3& dXs,
                                     const Vec3& normal, double normalForce, double tanFriction) {
   Vec3 trial = carriedShear - ks * dXs;
   trial -= normal * normal.dot(trial);
@@ -85,7 +85,7 @@ struct MomentResult {
 // Moment slot, elastic-perfectly-plastic: M <- carried M + Kr dTheta, |M| <= limit.
 // The Kozicki–Donzé preset passes the full relative rotation (bending and twisting with the same
 // Kr); the linear rolling preset passes only its bending part (see bendingPart).
-inline MomentResult momentElasticPlastic(const Vec3& carriedMoment, double kr, const Vec3& dTheta,
+GRAINLAB_ALWAYS_INLINE MomentResult momentElasticPlastic(const Vec3& carriedMoment, double kr, const Vec3& dTheta,
                                          double limit) {
   const Vec3 trial = carriedMoment + kr * dTheta;
   MomentResult r{trial, 0.0, false};

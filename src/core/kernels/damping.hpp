@@ -10,7 +10,7 @@ namespace grainlab::kernels {
 // expression: built component by component, it went through the stack and was read back with a
 // wider load than it was written with (a store-forwarding stall, the integrator's hottest
 // instructions in the profile). Multiplying by sign(v) = +-1 is exact.
-inline Vec3 localDamping(const Vec3& f, const Vec3& v, double alpha) {
+GRAINLAB_ALWAYS_INLINE Vec3 localDamping(const Vec3& f, const Vec3& v, double alpha) {
   return ((-alpha) * f.array().abs() * v.array().sign()).matrix();
 }
 
@@ -32,7 +32,7 @@ inline ViscousKick viscousMidpointKick(const Vec3& momentum, const Vec3& force, 
 // One damped leapfrog kick of a velocity v (or a sphere's angular velocity) under the load f (or
 // torque) with mass m and 1/m (or I and 1/I): [O]'s viscous midpoint kick when viscous > 0, else
 // Cundall's local damping with alpha. Updates v and returns the damping force over the step.
-inline Vec3 dampedKick(Vec3& v, const Vec3& f, double m, double invM, double h, double viscous, double alpha) {
+GRAINLAB_ALWAYS_INLINE Vec3 dampedKick(Vec3& v, const Vec3& f, double m, double invM, double h, double viscous, double alpha) {
   if (viscous > 0.0) {
     const ViscousKick kick = viscousMidpointKick(m * v, f, viscous, h);
     v = kick.momentum * invM;

@@ -80,7 +80,7 @@ struct ParticleWork {
 // Advances particle i by one step (see the top of this file). Periodic: the position also follows
 // the homogeneous flow of the cell.
 template <bool Periodic>
-inline ParticleWork integrateParticle(const IntegratorView& p, std::size_t i, const IntegratorStep& s) {
+GRAINLAB_ALWAYS_INLINE ParticleWork integrateParticle(const IntegratorView& p, std::size_t i, const IntegratorStep& s) {
   Vec3* const x = p.position;
   Vec3* const v = p.velocity;
   Quat* const q = p.orientation;
