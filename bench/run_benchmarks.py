@@ -232,7 +232,7 @@ def scenes(opt, res):
         # 3. Ellipsoids against spheres of the same volume: the [O] samples, alternated twice.
         spheroids = prepared_packing(opt.exe, "preset:ouadfel-spheroids", os.path.join(tmp, "spheroids"))
         spheres = prepared_packing(opt.exe, "preset:ouadfel-spheroids", os.path.join(tmp, "spheres"),
-                                   ["--set", 'sample.shape.type="sphere"'])
+                                   ["--set", 'sample.shape={ type = "sphere" }'])  # the whole table: elongation is refused for spheres
         rows = []
         for _ in range(2):
             for shape, path in (("spheres", spheres), ("spheroids", spheroids)):
