@@ -316,6 +316,8 @@ void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& 
   kernels::SphereLawConstants constants{ctx.model.young, ctx.model.poisson,     ctx.model.beta,
                                         ctx.model.eta,   ctx.model.tanFriction, ctx.dt};
   constants.periodic = Periodic;
+  constants.linearRolling = ctx.model.rolling == contact::RollingLaw::Linear;
+  constants.combine = ctx.model.combine;
   if constexpr (Periodic) constants.velocityGradient = ctx.cell.velocityGradient;
   const Particles& P = ctx.particles;
 #pragma omp for schedule(dynamic, 1) nowait
@@ -339,6 +341,7 @@ void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& 
           tile.prevNormal[k][j] = tile.prevNormal[k][0];
         }
         tile.radiusA[j] = tile.radiusA[0], tile.radiusB[j] = tile.radiusB[0], tile.fresh[j] = tile.fresh[0];
+        tile.muA[j] = tile.muA[0], tile.muB[j] = tile.muB[0];
       }
       kernels::sphereLawTile(constants, tile, padded);
       for (std::size_t j = 0; j < n; ++j) {
@@ -382,6 +385,7 @@ void evaluateSphereTiles(ContactList<SphereSphere>& list, const ContactContext& 
         tile.shear[k][n] = h.shearForce[k], tile.moment[k][n] = h.moment[k], tile.prevNormal[k][n] = h.prevNormal[k];
       }
       tile.radiusA[n] = P.radius[a], tile.radiusB[n] = P.radius[b];
+      tile.muA[n] = P.rollingFriction[a], tile.muB[n] = P.rollingFriction[b];
       slot[n++] = static_cast<std::uint32_t>(c);
       if (n == Tile::kSize) flush();
     }

@@ -53,9 +53,28 @@ Simulation jumbledCell() {
   return sim;
 }
 
-std::string stateAfter(const std::string& target, int steps, Simulation* out = nullptr, bool cell = false) {
+// The scene with [R]'s linear rolling resistance: per-grain rolling friction, combined by `rule`.
+Simulation jumbledRolling(contact::CombineRule rule) {
+  Simulation sim = jumbledScene();
+  sim.model.rolling = contact::RollingLaw::Linear;
+  sim.model.combine = rule;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> mu(0.0, 0.4);
+  for (std::size_t i = 0; i < sim.particles.size(); ++i) sim.particles.rollingFriction[i] = i % 7 == 0 ? 0.0 : mu(rng);
+  sim.dt = 0.2 * sim.criticalTimeStep();
+  return sim;
+}
+
+enum class Scene { Box, Cell, RollingMin, RollingMean, RollingHarmonic };
+
+std::string stateAfter(const std::string& target, int steps, Simulation* out = nullptr, Scene scene = Scene::Box) {
   kernels::selectSimdTarget(target);
-  Simulation sim = cell ? jumbledCell() : jumbledScene();
+  const bool cell = scene == Scene::Cell;
+  Simulation sim = scene == Scene::Cell              ? jumbledCell()
+                   : scene == Scene::RollingMin      ? jumbledRolling(contact::CombineRule::Min)
+                   : scene == Scene::RollingMean     ? jumbledRolling(contact::CombineRule::Mean)
+                   : scene == Scene::RollingHarmonic ? jumbledRolling(contact::CombineRule::Harmonic)
+                                                     : jumbledScene();
   for (int s = 0; s < steps; ++s) sim.step();
   // The particles, every contact list (history and result slots) and the energy ledger, as the
   // checkpoint writes them (not the whole saveState: it also holds structs whose padding bytes are
@@ -93,7 +112,7 @@ TEST(ContactSimd, EveryTargetGivesTheScalarPathsState) {
 
 TEST(ContactSimd, EveryTargetGivesTheScalarPathsStateInACell) {
   Simulation reference;
-  const std::string scalar = stateAfter("scalar", 300, &reference, true);
+  const std::string scalar = stateAfter("scalar", 300, &reference, Scene::Cell);
   EXPECT_GT(reference.energy.slip, 0.0);
   EXPECT_GT(reference.touchingPairs(), 100u);
   std::size_t images = 0;
@@ -103,7 +122,22 @@ TEST(ContactSimd, EveryTargetGivesTheScalarPathsStateInACell) {
   EXPECT_GT(reference.cell.stress.norm(), 0.0);
   for (const std::string& target : kernels::simdTargetNames()) {
     if (target == "scalar") continue;
-    EXPECT_TRUE(stateAfter(target, 300, nullptr, true) == scalar) << "target " << target << ": the state differs";
+    EXPECT_TRUE(stateAfter(target, 300, nullptr, Scene::Cell) == scalar) << "target " << target << ": the state differs";
+  }
+}
+
+// [R]'s law: bending only, Kr = Ks R^2, the limit from the two grains' rolling friction by each
+// combination rule (some grains with mu_r = 0).
+TEST(ContactSimd, EveryTargetGivesTheScalarPathsStateWithLinearRolling) {
+  for (Scene scene : {Scene::RollingMin, Scene::RollingMean, Scene::RollingHarmonic}) {
+    Simulation reference;
+    const std::string scalar = stateAfter("scalar", 300, &reference, scene);
+    EXPECT_GT(reference.energy.rolling, 0.0);
+    for (const std::string& target : kernels::simdTargetNames()) {
+      if (target == "scalar") continue;
+      EXPECT_TRUE(stateAfter(target, 300, nullptr, scene) == scalar)
+          << "target " << target << ", rule " << static_cast<int>(scene) << ": the state differs";
+    }
   }
 }
 
@@ -115,7 +149,10 @@ TEST(ContactSimd, TakenOnlyForTheLawItCovers) {
   EXPECT_FALSE(kernels::sphereLawVectorised(hm));
   contact::SphereContactModel rr = m;
   rr.rolling = contact::RollingLaw::Linear;
-  EXPECT_FALSE(kernels::sphereLawVectorised(rr));
+  EXPECT_TRUE(kernels::sphereLawVectorised(rr));
+  contact::SphereContactModel none = m;
+  none.rolling = contact::RollingLaw::None;
+  EXPECT_FALSE(kernels::sphereLawVectorised(none));
   contact::SphereContactModel yade = m;
   yade.yadeMomentLimit = true;
   EXPECT_FALSE(kernels::sphereLawVectorised(yade));

@@ -93,8 +93,27 @@ void SphereLawTileImpl(const SphereLawConstants& kc, SphereLawTile& t, std::size
     // Kr = beta Ks rA rB, arm = eta 0.5 (rA + rB), all left to right
     const V kn = hn::Div(hn::Mul(hn::Mul(twoYoung, rA), rB), hn::Add(rA, rB));
     const V ks = hn::Mul(poisson, kn);
-    const V kr = hn::Mul(hn::Mul(hn::Mul(beta, ks), rA), rB);
-    const V arm = hn::Mul(etaHalf, hn::Add(rA, rB));
+    V kr, arm;
+    if (kc.linearRolling) {
+      // [R]: R = (rA rB)/(rA + rB), Kr = (Ks R) R, arm = mu_r(combined) R
+      const V rBar = hn::Div(hn::Mul(rA, rB), hn::Add(rA, rB));
+      kr = hn::Mul(hn::Mul(ks, rBar), rBar);
+      const V muA = hn::Load(d, t.muA + i), muB = hn::Load(d, t.muB + i);
+      V mu;
+      switch (kc.combine) {
+        case contact::CombineRule::Min: mu = hn::IfThenElse(hn::Lt(muB, muA), muB, muA); break;  // std::min
+        case contact::CombineRule::Mean: mu = hn::Mul(half, hn::Add(muA, muB)); break;
+        case contact::CombineRule::Harmonic: {
+          const V sum = hn::Add(muA, muB);
+          mu = hn::IfThenElse(hn::Gt(sum, zero), hn::Div(hn::Mul(hn::Mul(two, muA), muB), sum), zero);
+          break;
+        }
+      }
+      arm = hn::Mul(mu, rBar);
+    } else {
+      kr = hn::Mul(hn::Mul(hn::Mul(beta, ks), rA), rB);
+      arm = hn::Mul(etaHalf, hn::Add(rA, rB));
+    }
     // pairKinematics: vrel = (vb + wb x branchB) - (va + wa x branchA), spin = wb - wa,
     // meanSpinNormal = 0.5 ((wa + wb) . N)
     const V3 va = load3(t.va, i), vb = load3(t.vb, i), wa = load3(t.wa, i), wb = load3(t.wb, i);
@@ -132,8 +151,13 @@ void SphereLawTileImpl(const SphereLawConstants& kc, SphereLawTile& t, std::size
     trial = sub(trial, scale(dot(normal, trial), normal));
     const Limited shear = limitTo(trial, hn::Mul(fn, tanF), ks);
     // momentElasticPlastic(frame * M, Kr, spin dt, arm fn): trial = carried + Kr dTheta
-    const V3 dTheta = scale(dt, spin);
-    const V3 carriedMoment = rotate(fw, fu, invNorm2, load3(t.moment, i));
+    V3 dTheta = scale(dt, spin);
+    V3 carriedMoment = rotate(fw, fu, invNorm2, load3(t.moment, i));
+    if (kc.linearRolling) {
+      // bending only: bendingPart(x, N) = x - N (N . x), of the increment and of the carried moment
+      dTheta = sub(dTheta, scale(dot(normal, dTheta), normal));
+      carriedMoment = sub(carriedMoment, scale(dot(normal, carriedMoment), normal));
+    }
     const Limited moment = limitTo(add(carriedMoment, scale(kr, dTheta)), hn::Mul(arm, fn), kr);
     // force = Fn + Fs; storePair: torqueA = branchA x (-F) + M, torqueB = branchB x F - M
     const V3 force = add(normalForce, shear.value);
@@ -158,8 +182,9 @@ namespace grainlab::kernels {
 HWY_EXPORT(SphereLawTileImpl);
 
 bool sphereLawVectorised(const contact::SphereContactModel& m) {
-  return simdEnabled() && !m.hertz() && m.rolling == contact::RollingLaw::KozickiDonze && !m.yadeMomentLimit &&
-         m.constantKn <= 0.0 && m.beta > 0.0 && m.poisson > 0.0 && m.young > 0.0;
+  const bool moments = (m.rolling == contact::RollingLaw::KozickiDonze && !m.yadeMomentLimit && m.beta > 0.0) ||
+                       m.rolling == contact::RollingLaw::Linear;
+  return simdEnabled() && !m.hertz() && moments && m.constantKn <= 0.0 && m.poisson > 0.0 && m.young > 0.0;
 }
 
 void sphereLawTile(const SphereLawConstants& k, SphereLawTile& t, std::size_t count) {
