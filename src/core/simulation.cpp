@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cmath>
 #include <limits>
 
@@ -617,11 +618,19 @@ void Simulation::saveState(std::ostream& out) const {
   using namespace stateio;
   particles.saveState(out);
   put(out, boundary);
-  put(out, box);
+  // The box and the model have padding: written field by field into their layout, padding zero.
+  static_assert(sizeof(WallBox) == sizeof(box.walls) + sizeof(double) && offsetof(WallBox, referenceVolume) == sizeof(box.walls),
+                "WallBox changed: update its writer");
+  for (const Wall& w : box.walls)
+    putFields(out, w, &Wall::axis, &Wall::side, &Wall::position, &Wall::velocity, &Wall::control, &Wall::targetStress,
+              &Wall::tanFriction, &Wall::servoIntegral, &Wall::normalForce, &Wall::contactStiffness, &Wall::contacts);
+  put(out, box.referenceVolume);
   saveCell(out);
   broadPhase.saveState(out);
   contacts.forEach([&](const auto& list) { list.saveState(out); });
-  put(out, model);
+  using M = contact::SphereContactModel;
+  putFields(out, model, &M::young, &M::poisson, &M::tanFriction, &M::rolling, &M::beta, &M::eta, &M::combine,
+            &M::yadeMomentLimit, &M::constantKn, &M::law, &M::restitutionBeta, &M::referenceStress);
   put(out, servo);
   put(out, energy);
   put(out, gravity);

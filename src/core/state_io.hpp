@@ -100,6 +100,21 @@ void get(std::istream& in, T& value) {
   detail::readBytes(in, &value, sizeof(T));
 }
 
+// A struct with padding, written as its bytes (the layout `get` reads back) but with the padding
+// as zeros: `put` copies whatever the padding holds (uninitialised stack or heap bytes), so two
+// saves of equal states could differ, and those bytes would end up in the file. Every field must
+// be listed (checked against fieldCount).
+template <class T, class... M>
+void putFields(std::ostream& out, const T& value, M T::*... fields) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  static_assert(fieldCount<T>() == sizeof...(M), "list every field of the struct");
+  alignas(T) unsigned char bytes[sizeof(T)] = {};
+  const auto* base = reinterpret_cast<const unsigned char*>(&value);
+  (std::memcpy(bytes + (reinterpret_cast<const unsigned char*>(&(value.*fields)) - base), &(value.*fields), sizeof(M)),
+   ...);
+  out.write(reinterpret_cast<const char*>(bytes), sizeof(T));
+}
+
 inline void put(std::ostream& out, bool value) { put(out, static_cast<std::uint8_t>(value ? 1 : 0)); }
 inline void get(std::istream& in, bool& value) {
   std::uint8_t b = 0;

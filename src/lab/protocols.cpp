@@ -298,7 +298,16 @@ void Laboratory::saveState(std::ostream& out) const {
   put(out, st.loopRestStart);
   put(out, st.slowdown);
   put(out, protocol_ != nullptr);
-  if (protocol_) put(out, protocol_->state);
+  if (protocol_) {
+    // Padding written as zeros (stateio::putFields), the layout the loader reads.
+    using S = ProtocolState;
+    putFields(out, protocol_->state, &S::direction, &S::path, &S::lastEps1, &S::halfCycles, &S::cycleEpsMin,
+              &S::cycleEpsMax, &S::doubleAmplitude, &S::ruMax, &S::liquefiedCycles, &S::volumeDriftMax, &S::done,
+              &S::recordDue, &S::lastRecorded, &S::segment, &S::segmentStart, &S::target, &S::stressDeviationMax,
+              &S::pathFailed, &S::gamma0, &S::amplitude, &S::returning, &S::lastGamma, &S::lastTau, &S::cycleGammaMin,
+              &S::cycleGammaMax, &S::cycleTauMin, &S::cycleTauMax, &S::loopArea, &S::secantModulus, &S::dampingRatio,
+              &S::measuredAmplitude, &S::amplitudesDone);
+  }
 }
 
 void Laboratory::loadState(std::istream& in) {
