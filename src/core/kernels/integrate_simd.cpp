@@ -28,29 +28,42 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), minusOne = hn::Set(d, -1.0), half = hn::Set(d, 0.5);
   const V h = hn::Set(d, s.h), halfH = hn::Set(d, 0.5 * s.h), minusAlpha = hn::Set(d, -s.localDamping);
   const V g0 = hn::Set(d, s.gravity[0]), g1 = hn::Set(d, s.gravity[1]), g2 = hn::Set(d, s.gravity[2]);
-  V m00, m01, m02, m10, m11, m12, m20, m21, m22;
-  if constexpr (Periodic) {
-    const Mat3& M = s.flowStep;
-    m00 = hn::Set(d, M(0, 0)), m01 = hn::Set(d, M(0, 1)), m02 = hn::Set(d, M(0, 2));
-    m10 = hn::Set(d, M(1, 0)), m11 = hn::Set(d, M(1, 1)), m12 = hn::Set(d, M(1, 2));
-    m20 = hn::Set(d, M(2, 0)), m21 = hn::Set(d, M(2, 1)), m22 = hn::Set(d, M(2, 2));
-  }
+  // A 3 x 3 matrix broadcast to every lane, and its product with a vector of lanes in Eigen's
+  // order: rows 0 and 1 in one SSE2 register, (M0 x0 + M1 x1) + M2 x2; row 2 by its scalar
+  // unroller, M0 x0 + (M1 x1 + M2 x2).
+  struct Matrix {
+    V e[3][3];
+  };
+  auto broadcast = [&](const Mat3& M) {
+    Matrix r;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r.e[i][j] = hn::Set(d, M(i, j));
+    return r;
+  };
+  auto times = [](const Matrix& M, V x0, V x1, V x2, V& r0, V& r1, V& r2) {
+    r0 = hn::Add(hn::Add(hn::Mul(M.e[0][0], x0), hn::Mul(M.e[0][1], x1)), hn::Mul(M.e[0][2], x2));
+    r1 = hn::Add(hn::Add(hn::Mul(M.e[1][0], x0), hn::Mul(M.e[1][1], x1)), hn::Mul(M.e[1][2], x2));
+    r2 = hn::Add(hn::Mul(M.e[2][0], x0), hn::Add(hn::Mul(M.e[2][1], x1), hn::Mul(M.e[2][2], x2)));
+  };
+  Matrix flow{}, deformation{};
+  if constexpr (Periodic) flow = broadcast(s.flowStep), deformation = broadcast(c.deformation);
   // The checks (StepChecks): the build's deformation F (periodic), the box (walls).
   const bool measure = c.positionsAtBuild != nullptr;
   const double* const xBuild = measure ? c.positionsAtBuild->data() : nullptr;
-  V f00, f01, f02, f10, f11, f12, f20, f21, f22, lo0, lo1, lo2, up0, up1, up2;
-  if constexpr (Periodic) {
-    const Mat3& F = c.deformation;
-    f00 = hn::Set(d, F(0, 0)), f01 = hn::Set(d, F(0, 1)), f02 = hn::Set(d, F(0, 2));
-    f10 = hn::Set(d, F(1, 0)), f11 = hn::Set(d, F(1, 1)), f12 = hn::Set(d, F(1, 2));
-    f20 = hn::Set(d, F(2, 0)), f21 = hn::Set(d, F(2, 1)), f22 = hn::Set(d, F(2, 2));
-  } else {
+  V lo0, lo1, lo2, up0, up1, up2;
+  if constexpr (!Periodic) {
     lo0 = hn::Set(d, c.lower[0]), lo1 = hn::Set(d, c.lower[1]), lo2 = hn::Set(d, c.lower[2]);
     up0 = hn::Set(d, c.upper[0]), up1 = hn::Set(d, c.upper[1]), up2 = hn::Set(d, c.upper[2]);
   }
   V maxDisp2 = zero;
   // Eigen's sign(): +1, -1, or 0 where the value is 0.
   auto sign = [&](V a) { return hn::IfThenElse(hn::Gt(a, zero), one, hn::IfThenElse(hn::Lt(a, zero), minusOne, zero)); };
+  // dampedKick with local damping, per component: the damping load fd = ((-alpha) |f|) sign(v),
+  // and v + (f + fd) (h / m) (a spin: the torque and h / I).
+  auto kick = [&](V vel, V load, V hOverMass, V& damping) {
+    damping = hn::Mul(hn::Mul(minusAlpha, hn::Abs(load)), sign(vel));
+    return hn::Add(vel, hn::Mul(hn::Add(load, damping), hOverMass));
+  };
   // Eigen's 3-vector dot product: (a0 b0 + a1 b1) + a2 b2.
   auto dot = [](V a0, V a1, V a2, V b0, V b1, V b2) {
     return hn::Add(hn::Add(hn::Mul(a0, b0), hn::Mul(a1, b1)), hn::Mul(a2, b2));
@@ -77,22 +90,11 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
     f0 = hn::Add(f0, hn::Mul(m, g0));
     f1 = hn::Add(f1, hn::Mul(m, g1));
     f2 = hn::Add(f2, hn::Mul(m, g2));
-    // fd = ((-alpha) |f|) sign(v); v += (f + fd) (h / m)
-    const V fd0 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f0)), sign(v0));
-    const V fd1 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f1)), sign(v1));
-    const V fd2 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(f2)), sign(v2));
-    const V hm = hn::Mul(h, invM);
-    const V vn0 = hn::Add(v0, hn::Mul(hn::Add(f0, fd0), hm));
-    const V vn1 = hn::Add(v1, hn::Mul(hn::Add(f1, fd1), hm));
-    const V vn2 = hn::Add(v2, hn::Mul(hn::Add(f2, fd2), hm));
-    // the same for the spin with the torque and 1/I
-    const V td0 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t0)), sign(w0));
-    const V td1 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t1)), sign(w1));
-    const V td2 = hn::Mul(hn::Mul(minusAlpha, hn::Abs(t2)), sign(w2));
-    const V hi = hn::Mul(h, invI);
-    const V wn0 = hn::Add(w0, hn::Mul(hn::Add(t0, td0), hi));
-    const V wn1 = hn::Add(w1, hn::Mul(hn::Add(t1, td1), hi));
-    const V wn2 = hn::Add(w2, hn::Mul(hn::Add(t2, td2), hi));
+    // the damped kicks of the velocity (force, h / m) and of the spin (torque, h / I)
+    const V hm = hn::Mul(h, invM), hi = hn::Mul(h, invI);
+    V fd0, fd1, fd2, td0, td1, td2;
+    const V vn0 = kick(v0, f0, hm, fd0), vn1 = kick(v1, f1, hm, fd1), vn2 = kick(v2, f2, hm, fd2);
+    const V wn0 = kick(w0, t0, hi, td0), wn1 = kick(w1, t1, hi, td1), wn2 = kick(w2, t2, hi, td2);
     // q <- Quat(1, (0.5 h) w) * q, renormalised, where |w|^2 > 0 (Eigen's SSE quaternion product)
     const auto spinning = hn::Gt(hn::Add(hn::Add(hn::Mul(wn0, wn0), hn::Mul(wn1, wn1)), hn::Mul(wn2, wn2)), zero);
     if (!hn::AllFalse(d, spinning)) {
@@ -120,12 +122,10 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
     const V dw = dot(td0, td1, td2, hn::Mul(half, hn::Add(w0, wn0)), hn::Mul(half, hn::Add(w1, wn1)),
                      hn::Mul(half, hn::Add(w2, wn2)));
     hn::Store(hn::Mul(h, hn::Add(dv, dw)), d, damping);
-    // x += v h (periodic: x += v h + M x, the product with the old x in Eigen's order: rows 0 and 1
-    // in one SSE2 register, (M0 x0 + M1 x1) + M2 x2; row 2 by its scalar unroller, M0 x0 + (M1 x1 + M2 x2))
+    // x += v h (periodic: x += v h + M x, the product with the old x)
     if constexpr (Periodic) {
-      const V mx0 = hn::Add(hn::Add(hn::Mul(m00, x0), hn::Mul(m01, x1)), hn::Mul(m02, x2));
-      const V mx1 = hn::Add(hn::Add(hn::Mul(m10, x0), hn::Mul(m11, x1)), hn::Mul(m12, x2));
-      const V mx2 = hn::Add(hn::Mul(m20, x0), hn::Add(hn::Mul(m21, x1), hn::Mul(m22, x2)));
+      V mx0, mx1, mx2;
+      times(flow, x0, x1, x2, mx0, mx1, mx2);
       x0 = hn::Add(x0, hn::Add(hn::Mul(vn0, h), mx0));
       x1 = hn::Add(x1, hn::Add(hn::Mul(vn1, h), mx1));
       x2 = hn::Add(x2, hn::Add(hn::Mul(vn2, h), mx2));
@@ -143,15 +143,13 @@ std::size_t SpheresT(const IntegratorView& p, std::size_t begin, std::size_t end
       work[i - begin + k].damping = damping[k];
       work[i - begin + k].gravity = s.gravityOn ? gravityWork[k] : 0.0;
     }
-    // checks: |x - x_build|^2 (cell: |x - F x_build|^2, F x_build in Eigen's row order as M x
-    // above), then finite state and (walls) inside the box: x - lo > -r and hi - x > -r
+    // checks: |x - x_build|^2 (cell: |x - F x_build|^2), then finite state and (walls) inside the box: x - lo > -r and hi - x > -r
     if (measure) {
       V b0, b1, b2;
       hn::LoadInterleaved3(d, xBuild + 3 * i, b0, b1, b2);
       if constexpr (Periodic) {
-        const V fb0 = hn::Add(hn::Add(hn::Mul(f00, b0), hn::Mul(f01, b1)), hn::Mul(f02, b2));
-        const V fb1 = hn::Add(hn::Add(hn::Mul(f10, b0), hn::Mul(f11, b1)), hn::Mul(f12, b2));
-        const V fb2 = hn::Add(hn::Mul(f20, b0), hn::Add(hn::Mul(f21, b1), hn::Mul(f22, b2)));
+        V fb0, fb1, fb2;
+        times(deformation, b0, b1, b2, fb0, fb1, fb2);
         b0 = fb0, b1 = fb1, b2 = fb2;
       }
       const V d0 = hn::Sub(x0, b0), d1 = hn::Sub(x1, b1), d2 = hn::Sub(x2, b2);
