@@ -30,18 +30,21 @@ struct TestTypeInfo {
   DrivingStrain strain;
   bool periodicOnly;       // needs test.boundary = "periodic"
   bool drainage;           // test.drainage = "undrained" applies
+  // Its report is a monotonic curve's (peak, residual, dilatancy, E50, critical state); the other
+  // shearing tests report their own macro-values (lab/test_report.hpp, lab/run_report.hpp).
+  bool monotonic;
 };
 
 inline constexpr std::array<TestTypeInfo, 9> kTestTypes{{
-    {TestType::Isotropic, "isotropic", "isotropic consolidation", DrivingStrain::None, false, false},
-    {TestType::Triaxial, "triaxial", "triaxial shearing", DrivingStrain::Axial, false, true},
-    {TestType::ConstantP, "constant-p", "constant-p", DrivingStrain::Axial, false, false},
-    {TestType::TrueTriaxial, "true-triaxial", "true-triaxial", DrivingStrain::Axial, false, false},
-    {TestType::SimpleShear, "simple-shear", "simple-shear", DrivingStrain::Shear, true, true},
-    {TestType::Oedometer, "oedometer", "oedometer", DrivingStrain::Axial, false, false},
-    {TestType::CyclicTriaxial, "cyclic-triaxial", "cyclic triaxial", DrivingStrain::Axial, false, true},
-    {TestType::StressPath, "stress-path", "stress path", DrivingStrain::Axial, false, false},
-    {TestType::CyclicSimpleShear, "cyclic-simple-shear", "cyclic simple shear", DrivingStrain::Shear, true, true},
+    {TestType::Isotropic, "isotropic", "isotropic consolidation", DrivingStrain::None, false, false, false},
+    {TestType::Triaxial, "triaxial", "triaxial shearing", DrivingStrain::Axial, false, true, true},
+    {TestType::ConstantP, "constant-p", "constant-p", DrivingStrain::Axial, false, false, true},
+    {TestType::TrueTriaxial, "true-triaxial", "true-triaxial", DrivingStrain::Axial, false, false, true},
+    {TestType::SimpleShear, "simple-shear", "simple-shear", DrivingStrain::Shear, true, true, true},
+    {TestType::Oedometer, "oedometer", "oedometer", DrivingStrain::Axial, false, false, false},
+    {TestType::CyclicTriaxial, "cyclic-triaxial", "cyclic triaxial", DrivingStrain::Axial, false, true, false},
+    {TestType::StressPath, "stress-path", "stress path", DrivingStrain::Axial, false, false, false},
+    {TestType::CyclicSimpleShear, "cyclic-simple-shear", "cyclic simple shear", DrivingStrain::Shear, true, true, false},
 }};
 
 inline const TestTypeInfo& info(TestType t) {

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "core/errors.hpp"
+#include "lab/run_report.hpp"
 #include "lab/test_report.hpp"
 
 using namespace grainlab;
@@ -82,4 +84,59 @@ TEST(LabReport, OedometerWithoutLoadingIsNull) {
   const lab::OedometerSummary s = lab::oedometerSummary({x, x}, 100e3);
   EXPECT_FALSE(s.cc);
   EXPECT_FALSE(s.k0);
+}
+
+// The run report (lab/run_report.hpp): summary keys from the probe and the records.
+
+// A probe that measured nu0 outside [0, 1/2] did not measure an elastic Poisson ratio: nu0 (and its
+// alias nu) is null, the measured number is kept beside it, and a warning says so.
+TEST(RunReport, ProbeNullsAPoissonRatioOutsideTheElasticRange) {
+  lab::ModulusProbe probe;
+  probe.elastic = lab::ElasticConstants{50e6, -0.2};
+  probe.method = "hand";
+  lab::Json s;
+  lab::reportProbe(probe, s);
+  EXPECT_DOUBLE_EQ(s["E0_MPa"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(s["E_MPa"].get<double>(), 50.0);
+  EXPECT_TRUE(s["nu0"].is_null());
+  EXPECT_TRUE(s["nu"].is_null());
+  EXPECT_DOUBLE_EQ(s["nu0_measured"].get<double>(), -0.2);
+  ASSERT_EQ(s["warnings"].size(), 1u);
+  EXPECT_NE(s["warnings"][0].get<std::string>().find("-0.200"), std::string::npos);
+  EXPECT_EQ(s["E0_method"], "hand");
+}
+
+// A non-positive E0 is null with E0_MPa_measured; a probe that measured nothing gives nulls and no
+// warning; a non-finite modulus is refused, never written.
+TEST(RunReport, ProbeNullsANonPositiveModulusAndRefusesNaN) {
+  lab::ModulusProbe probe;
+  probe.elastic = lab::ElasticConstants{-3e6, 0.25};
+  lab::Json s;
+  lab::reportProbe(probe, s);
+  EXPECT_TRUE(s["E0_MPa"].is_null());
+  EXPECT_DOUBLE_EQ(s["E0_MPa_measured"].get<double>(), -3.0);
+  EXPECT_DOUBLE_EQ(s["nu0"].get<double>(), 0.25);
+
+  lab::Json none;
+  lab::reportProbe(lab::ModulusProbe{}, none);
+  EXPECT_TRUE(none["E0_MPa"].is_null());
+  EXPECT_TRUE(none["nu0"].is_null());
+  EXPECT_FALSE(none.contains("warnings"));
+
+  probe.elastic = lab::ElasticConstants{std::nan(""), 0.25};
+  lab::Json bad;
+  EXPECT_THROW(lab::reportProbe(probe, bad), SimulationError);
+}
+
+// A record's micromechanics by column name: a value that could not be measured is null, not 0.
+TEST(RunReport, MicroColumnsNullWhereNotMeasured) {
+  lab::Record r;
+  r.eps1 = 0.03;
+  r.micro = {1.5, std::nan("")};
+  r.energyResidual = std::nan("");
+  const lab::Json j = lab::microJson(r, {"Z", "a_r"});
+  EXPECT_DOUBLE_EQ(j["Z"].get<double>(), 1.5);
+  EXPECT_TRUE(j["a_r"].is_null());
+  EXPECT_TRUE(j["energy_residual"].is_null());
+  EXPECT_DOUBLE_EQ(j["eps1"].get<double>(), 0.03);
 }
