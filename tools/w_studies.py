@@ -55,6 +55,11 @@ STUDIES = [
 ]
 
 
+def shown(value):
+    """A summary number to one decimal, or "null" where it was not measured."""
+    return "null" if value is None else f"{value:.1f}"
+
+
 def nu_text(summary):
     """nu of the summary for the table: null outside [0, 0.5] (study_runs.elastic_nu)."""
     nu = elastic_nu(summary.get("nu"))
@@ -230,7 +235,7 @@ def size(opt):
                     f"{summary['phi_res_deg']:.1f} | {summary['psi_max_deg']:.1f} | {summary['E_MPa']:.0f} | "
                     f"{residual_state(summary)[0]:.2f} | {residual_state(summary)[1]:.3f} | "
                     f"{100 * summary['lateral_stress_max_deviation']:.1f} | "
-                    f"{summary['rotation_band_mean_deg']:.1f} / {summary['rotation_outside_band_mean_deg']:.1f} | "
+                    f"{shown(summary['rotation_band_mean_deg'])} / {shown(summary['rotation_outside_band_mean_deg'])} | "
                     f"{summary['wall_seconds']:.0f} |")
         eps1 = [100 * float(r["eps1"]) for r in series]
         legend = f"{n} spheres (e0 {summary['e0']:.3f})"

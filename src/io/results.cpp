@@ -83,10 +83,12 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
                              r.phiDeg, r.coordination, r.unbalanced, r.eps2, r.eps3,
                              r.inertialNumber, r.sigma1Contact, r.sigma2Contact, r.sigma3Contact,
                              r.kinetic, r.elastic, r.workBoundary, r.dissipSlip, r.dissipRoll,
-                             r.dissipDamping, r.rotationMeanDeg, r.rotationBandMeanDeg,
-                             r.bandFraction};
+                             r.dissipDamping};
     s += fmt::format("{}", r.step);
     for (double v : values) put(r.step, v);
+    // The rotation means and the band fraction: an empty field where not measured (lab/kinematics.hpp).
+    for (double v : {r.rotationMeanDeg, r.rotationBandMeanDeg, r.bandFraction})
+      s += std::isfinite(v) ? fmt::format(",{:.10g}", v) : std::string(",");
     if (columns.periodic) {
       put(r.step, r.eps1Log);
       put(r.step, r.stressSkew);

@@ -1,5 +1,7 @@
 #include "lab/kinematics.hpp"
 
+#include <limits>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -111,10 +113,14 @@ GrainKinematics grainKinematics(const Simulation& sim, const GrainRecords& recor
     (in ? sumBand : sumOut) += k.rotationDeg[i];
     band += in;
   }
-  k.rotationMeanDeg = counted ? sumAll / counted : 0.0;
-  k.rotationBandMeanDeg = band ? sumBand / band : 0.0;
-  k.rotationOutsideMeanDeg = counted > band ? sumOut / (counted - band) : 0.0;
-  k.bandFraction = counted ? static_cast<double>(band) / counted : 0.0;
+  // A mean over no grain is not measured (NaN: null in the summary, an empty field in the time
+  // series), and without a homogeneous strain there is no band criterion at all.
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  const bool classified = k.boxShearStrain > 0.0 && counted > 0;
+  k.rotationMeanDeg = counted ? sumAll / counted : none;
+  k.rotationBandMeanDeg = classified && band ? sumBand / band : none;
+  k.rotationOutsideMeanDeg = classified && counted > band ? sumOut / (counted - band) : none;
+  k.bandFraction = classified ? static_cast<double>(band) / counted : none;
   return k;
 }
 

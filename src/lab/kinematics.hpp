@@ -26,10 +26,13 @@ struct GrainKinematics {
   std::vector<double> localShearStrain; // eq of the local Green–Lagrange strain [-]
   std::vector<double> inBand;           // 1 in the band, 0 outside
   double boxShearStrain = 0.0;
+  // Means over the active grains, overall, inside and outside the band, and the band's fraction of
+  // them; NaN (not measured) over no grain, and the last three NaN while boxShearStrain = 0 (no
+  // band criterion without a homogeneous strain).
   double rotationMeanDeg = 0.0;
-  double rotationBandMeanDeg = 0.0;     // 0 when no grain is in the band
+  double rotationBandMeanDeg = 0.0;
   double rotationOutsideMeanDeg = 0.0;
-  double bandFraction = 0.0;            // of the active grains
+  double bandFraction = 0.0;
 };
 
 // Equivalent shear strain sqrt(2/3 e:e) of the deviator of a strain tensor.

@@ -22,6 +22,8 @@ double finite(double v, const char* name) {
 }
 
 Json optional(const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); }
+// A value that is NaN where it could not be measured.
+Json measured(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 Json gradingJson(const GradingStats& g) {
   return {{"d10", g.d10}, {"d30", g.d30}, {"d50", g.d50}, {"d60", g.d60},
@@ -288,7 +290,8 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   if (lab.protocol()->undrained()) undrainedKeys(config, records, lab.protocol()->state.volumeDriftMax, s);
   s["strain_rate"] = shear.strainRate;
   s["inertial_number"] = shear.inertialNumber;
-  s["lateral_stress_max_deviation"] = shear.maxLateralDeviation;
+  // Simple shear has no lateral stress target: not measured.
+  s["lateral_stress_max_deviation"] = simpleShear ? Json(nullptr) : Json(shear.maxLateralDeviation);
   if (config.test.boundary == "walls") s["lateral_stress_max_deviation_single_wall"] = shear.maxSingleWallDeviation;
   s["shear_pipeline"] = lab.shearStageNames();
   if (shear.maxLateralDeviation > 0.02)
@@ -311,10 +314,11 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["energy_residual_max"] = optional(residualMax);
   // Grain rotations at the end of the test, inside and outside the shear band (kinematics.hpp).
   const GrainKinematics k = lab.currentKinematics();
-  s["rotation_mean_deg"] = k.rotationMeanDeg;
-  s["rotation_band_mean_deg"] = k.rotationBandMeanDeg;
-  s["rotation_outside_band_mean_deg"] = k.rotationOutsideMeanDeg;
-  s["band_fraction"] = k.bandFraction;
+  // Null where not measured (no grain in the band, or no homogeneous strain to compare with).
+  s["rotation_mean_deg"] = measured(k.rotationMeanDeg);
+  s["rotation_band_mean_deg"] = measured(k.rotationBandMeanDeg);
+  s["rotation_outside_band_mean_deg"] = measured(k.rotationOutsideMeanDeg);
+  s["band_fraction"] = measured(k.bandFraction);
   // I = rate d50 sqrt(rho/p) with the p measured at each record.
   const double inertialMax = inertialMaxOf(records);
   s["inertial_number_max"] = inertialMax;

@@ -66,6 +66,11 @@ def test_simple_shear_in_the_cell(grainlab, data_dir, tmp_path):
     assert summary["G_MPa"] > 0
     assert summary["E_MPa"] is None and summary["nu"] is None
     assert 10 < summary["phi_peak_deg"] < 60
+    # Not measured is null, never 0: simple shear has no lateral stress target, and the mean
+    # rotation in the band is an empty field exactly where no grain is in the band.
+    assert summary["lateral_stress_max_deviation"] is None
+    for r in rows:
+        assert (r["rotation_band_mean_deg"] == "") == (r["band_fraction"] == "" or float(r["band_fraction"]) == 0)
 
 
 def test_periodic_results_do_not_depend_on_threads(grainlab, data_dir, tmp_path):
