@@ -26,6 +26,7 @@ GrainKinematics grainKinematics(const Simulation& sim, const GrainRecords& recor
   k.localShearStrain.assign(n, 0.0);
   k.inBand.assign(n, 0.0);
   k.boxShearStrain = equivalentShearStrain(boxStrain);
+  k.active = active;
   for (std::size_t i = 0; i < n; ++i) {
     k.displacement[i] = records.displacement(sim, i);
     k.rotationDeg[i] = radToDeg(records.rotationAngle(P, i));

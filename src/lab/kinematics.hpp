@@ -25,6 +25,7 @@ struct GrainKinematics {
   std::vector<double> rotationDeg;      // angle of the composed rotation since the reference [deg]
   std::vector<double> localShearStrain; // eq of the local Green–Lagrange strain [-]
   std::vector<double> inBand;           // 1 in the band, 0 outside
+  std::vector<char> active;             // the load-bearing grains counted (empty: every grain)
   double boxShearStrain = 0.0;
   // Means over the active grains, overall, inside and outside the band, and the band's fraction of
   // them; NaN (not measured) over no grain, and the last three NaN while boxShearStrain = 0 (no

@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "lab/micro_network.hpp"
+#include "lab/shear_band.hpp"
 #include "lab/test_report.hpp"
 
 namespace grainlab::lab {
@@ -209,6 +210,24 @@ void moduliFromLoops(const RunConfig& config, const std::vector<UnloadReloadLoop
                            : std::string());
 }
 
+// The shear band at the end of the test (lab/shear_band.hpp), null where none is found.
+Json shearBandJson(const RunConfig& config, const Simulation& sim, const GrainKinematics& k, double d50) {
+  if (config.test.boundary == "periodic") return nullptr;
+  ShearBandSettings settings;
+  settings.binWidth = d50;
+  const std::optional<ShearBand> b =
+      findShearBand(sim.particles.position, k.localShearStrain, k.inBand, k.active, settings);
+  if (!b) return nullptr;
+  return {{"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
+          {"thickness_d50", finite(b->thickness / d50, "shear_band.thickness_d50")},
+          {"normal", {b->normal.x(), b->normal.y(), b->normal.z()}},
+          {"centre", {b->centre.x(), b->centre.y(), b->centre.z()}},
+          {"grains", b->grains},
+          {"flatness", b->flatness},
+          {"peak_local_strain", b->peakStrain},
+          {"background_local_strain", b->backgroundStrain}};
+}
+
 double inertialMaxOf(const std::vector<Record>& records) {
   double inertialMax = 0.0;
   for (const auto& r : records) inertialMax = std::max(inertialMax, r.inertialNumber);
@@ -319,6 +338,14 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["rotation_band_mean_deg"] = measured(k.rotationBandMeanDeg);
   s["rotation_outside_band_mean_deg"] = measured(k.rotationOutsideMeanDeg);
   s["band_fraction"] = measured(k.bandFraction);
+  s["shear_band"] = shearBandJson(config, lab.simulation(), k, lab.d50());
+  s["shear_band_method"] =
+      "the load-bearing grains whose local eq since the start of shearing is >= output.band_factor times the "
+      "sample's (band_fraction); a band when they are >= 20 and <= half the load-bearing grains and lie in a slab "
+      "(smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the centroids of "
+      "full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, thickness_d50 "
+      "= full width at half height of the mean eq profile across it (bins of d50) above the background (the median "
+      "eq outside); null when any step fails, and in a periodic cell (a band may wrap across the faces)";
   // I = rate d50 sqrt(rho/p) with the p measured at each record.
   const double inertialMax = inertialMaxOf(records);
   s["inertial_number_max"] = inertialMax;

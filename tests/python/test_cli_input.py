@@ -222,3 +222,5 @@ def test_rolling_linear_sphericity_run(grainlab, tmp_path):
     header = (out / "timeseries.csv").read_text().splitlines()[0]
     assert "rotation_mean_deg" in header and "rotation_band_mean_deg" in header
     assert "rotation_band_mean_deg" in s and "rotation_outside_band_mean_deg" in s
+    # 80 grains between rigid walls do not localise: no band plane (null, not a guess).
+    assert "shear_band_method" in s and s["shear_band"] is None
