@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Plots of one grainlab results folder: q-eps1, eps_v-eps1, phi-eps1, e-eps1, energy (PNG in DIR/plots).
+"""Plots of one grainlab results folder: q-eps1, eps_v-eps1, phi-eps1, e-eps1, energy, and a slice of
+the local shear strain through the last particle snapshot (PNG in DIR/plots).
 
 Usage: plot_run.py DIR
 Reads DIR/timeseries.csv (and DIR/summary.json for the annotations). Signs as in docs/physics.md §1:
@@ -140,7 +141,61 @@ def main(directory):
         fig.tight_layout()
         save(fig, os.path.join(out, "energy.png"))
     laboratory_plots(data, summary, out, title)
+    band_slice(directory, summary, out, title)
     return 0
+
+
+def band_slice(directory, summary, out, title):
+    """plots/band_slice.png: the grains of the last particle snapshot within one d50 of the sample's
+    mid-plane y = const, coloured by their local shear strain, the band's grains outlined, and the
+    trace of the band's plane (summary shear_band) where one was found."""
+    import glob
+    snapshots = sorted(glob.glob(os.path.join(directory, "vtk", "particles_*.vtu")))
+    if not snapshots:
+        return
+    try:
+        import meshio
+        import numpy as np
+        m = meshio.read(snapshots[-1])
+    except Exception:  # noqa: BLE001 - the plot is optional; the results are complete without it
+        return
+    if "local_shear_strain" not in m.point_data:
+        return
+    x, y, z = m.points[:, 0], m.points[:, 1], m.points[:, 2]
+    d50 = (summary.get("grading") or {}).get("d50") or 2.0 * float(np.median(m.point_data["radius"]))
+    centre_y = 0.5 * (y.min() + y.max())
+    sel = np.abs(y - centre_y) < d50
+    if not sel.any():
+        return
+    eq = m.point_data["local_shear_strain"].ravel()
+    band = m.point_data["in_band"].ravel() > 0.5
+    aspect = (z.max() - z.min()) / max(x.max() - x.min(), 1e-300)
+    fig, ax = plt.subplots(figsize=(6.4, min(9.0, max(3.5, 4.4 * aspect + 1.4))))
+    pts = ax.scatter(1e3 * x[sel], 1e3 * z[sel], c=100.0 * eq[sel], s=12, cmap="viridis")
+    ax.scatter(1e3 * x[sel & band], 1e3 * z[sel & band], s=22, facecolors="none", edgecolors="r", lw=0.6,
+               label="in the band (eq >= band_factor x the sample's)")
+    sb = summary.get("shear_band")
+    if sb:
+        n, c = np.array(sb["normal"]), np.array(sb["centre"])
+        # The plane n.(p - c) = 0 in the slice y = centre_y, drawn across the sample's x range.
+        if abs(n[2]) > 1e-9:
+            xs = np.array([x.min(), x.max()])
+            zs = c[2] - (n[0] * (xs - c[0]) + n[1] * (centre_y - c[1])) / n[2]
+            ax.plot(1e3 * xs, 1e3 * zs, "r--", lw=1.0,
+                    label=f"band: {sb['inclination_deg']:.1f} deg, {sb['thickness_d50']:.1f} d50 thick")
+        else:
+            ax.axvline(1e3 * c[0], color="r", ls="--", lw=1.0, label="band: vertical")
+    else:
+        ax.set_title("no shear band found (summary shear_band = null)", fontsize=9)
+    fig.colorbar(pts, ax=ax, shrink=0.8, label="local shear strain eq since\nthe start of shearing [%]")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("z [mm]")
+    ax.set_aspect("equal")
+    ax.set_ylim(1e3 * z.min(), 1e3 * z.max())
+    ax.legend(fontsize=7, loc="lower left")
+    fig.suptitle(title + f"\nslice |y - y_mid| < d50, last snapshot", fontsize=9)
+    fig.tight_layout()
+    save(fig, os.path.join(out, "band_slice.png"))
 
 
 def laboratory_plots(data, summary, out, title):

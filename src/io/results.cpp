@@ -59,7 +59,8 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
   std::string s =
       "step,time,eps1,eps_v,sigma1,sigma2,sigma3,q,p,e,phi_deg,Z,unbalanced,eps2,eps3,"
       "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
-      "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction";
+      "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction,"
+      "band_inclination_deg,band_thickness_d50";
   if (columns.periodic) s += ",eps1_log,stress_skew";
   if (columns.simpleShear) s += ",gamma,tau";
   if (columns.trueTriaxial) s += ",b";
@@ -86,8 +87,10 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
                              r.dissipDamping};
     s += fmt::format("{}", r.step);
     for (double v : values) put(r.step, v);
-    // The rotation means and the band fraction: an empty field where not measured (lab/kinematics.hpp).
-    for (double v : {r.rotationMeanDeg, r.rotationBandMeanDeg, r.bandFraction})
+    // The rotation means, the band fraction and the band's plane: an empty field where not measured
+    // (lab/kinematics.hpp, lab/shear_band.hpp).
+    for (double v : {r.rotationMeanDeg, r.rotationBandMeanDeg, r.bandFraction, r.bandInclinationDeg,
+                     r.bandThicknessD50})
       s += std::isfinite(v) ? fmt::format(",{:.10g}", v) : std::string(",");
     if (columns.periodic) {
       put(r.step, r.eps1Log);

@@ -265,6 +265,13 @@ GrainKinematics Laboratory::currentKinematics() const {
                          active);
 }
 
+std::optional<ShearBand> Laboratory::shearBand(const GrainKinematics& k) const {
+  if (sim_.boundary == Boundary::Periodic) return std::nullopt;
+  ShearBandSettings settings;
+  settings.binWidth = d50_;
+  return findShearBand(sim_.particles.position, k.localShearStrain, k.inBand, k.active, settings);
+}
+
 void Laboratory::saveState(std::ostream& out) const {
   using namespace stateio;
   sim_.saveState(out);

@@ -16,6 +16,7 @@
 #include "lab/grading.hpp"
 #include "lab/grain_records.hpp"
 #include "lab/kinematics.hpp"
+#include "lab/shear_band.hpp"
 #include "lab/micromechanics.hpp"
 #include "lab/moduli.hpp"
 #include "lab/protocol/shear_protocol.hpp"
@@ -47,6 +48,8 @@ struct Record {
   double sigma1Now = 0.0, sigma2Now = 0.0, sigma3Now = 0.0;
   double sigma1Unbalanced = 0.0, sigma2Unbalanced = 0.0, sigma3Unbalanced = 0.0;
   double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
+  // The shear band's plane at the record (lab/shear_band.hpp): NaN where none is found.
+  double bandInclinationDeg = 0.0, bandThicknessD50 = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
          dissipDamping = 0.0;
   double workGravity = 0.0;  // work of gravity on the particles [J] (sample.gravity)
@@ -220,6 +223,9 @@ class Laboratory {
   // Grain displacement, rotation, local strain and shear band since the start of shearing; the
   // neighbourhood of the local strain is kNeighbourhoodDiameters * d50.
   GrainKinematics currentKinematics() const;
+  // The shear band of those kinematics (lab/shear_band.hpp, bins of d50); none in a periodic cell,
+  // where a band may wrap across the faces.
+  std::optional<ShearBand> shearBand(const GrainKinematics& k) const;
   static constexpr double kNeighbourhoodDiameters = 2.0;
   static constexpr double kPlatenRampIntegralTimes = 40.0;
   static constexpr double kAutoInertialNumber = 0.98e-3;

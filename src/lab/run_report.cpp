@@ -211,12 +211,7 @@ void moduliFromLoops(const RunConfig& config, const std::vector<UnloadReloadLoop
 }
 
 // The shear band at the end of the test (lab/shear_band.hpp), null where none is found.
-Json shearBandJson(const RunConfig& config, const Simulation& sim, const GrainKinematics& k, double d50) {
-  if (config.test.boundary == "periodic") return nullptr;
-  ShearBandSettings settings;
-  settings.binWidth = d50;
-  const std::optional<ShearBand> b =
-      findShearBand(sim.particles.position, k.localShearStrain, k.inBand, k.active, settings);
+Json shearBandJson(const std::optional<ShearBand>& b, double d50) {
   if (!b) return nullptr;
   return {{"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
           {"thickness_d50", finite(b->thickness / d50, "shear_band.thickness_d50")},
@@ -338,14 +333,20 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["rotation_band_mean_deg"] = measured(k.rotationBandMeanDeg);
   s["rotation_outside_band_mean_deg"] = measured(k.rotationOutsideMeanDeg);
   s["band_fraction"] = measured(k.bandFraction);
-  s["shear_band"] = shearBandJson(config, lab.simulation(), k, lab.d50());
+  s["shear_band"] = shearBandJson(lab.shearBand(k), lab.d50());
+  const std::optional<double> onset = bandOnset(records);
+  s["shear_band_onset_eps1"] = optional(onset);
+  s["shear_band_onset_over_peak"] =
+      onset && m.eps1AtPeak > 0.0 ? Json(finite(*onset / m.eps1AtPeak, "shear_band_onset_over_peak")) : Json(nullptr);
   s["shear_band_method"] =
       "the load-bearing grains whose local eq since the start of shearing is >= output.band_factor times the "
       "sample's (band_fraction); a band when they are >= 20 and <= half the load-bearing grains and lie in a slab "
       "(smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the centroids of "
       "full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, thickness_d50 "
       "= full width at half height of the mean eq profile across it (bins of d50) above the background (the median "
-      "eq outside); null when any step fails, and in a periodic cell (a band may wrap across the faces)";
+      "eq outside); null when any step fails, and in a periodic cell (a band may wrap across the faces); the same at every "
+      "record (timeseries band_inclination_deg, band_thickness_d50); shear_band_onset_eps1 = the first record "
+      "from which every record to the end has a band, shear_band_onset_over_peak = that over eps1_at_peak";
   // I = rate d50 sqrt(rho/p) with the p measured at each record.
   const double inertialMax = inertialMaxOf(records);
   s["inertial_number_max"] = inertialMax;
@@ -556,6 +557,12 @@ ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Labor
   else
     reportReversing(config, shear, lab, summary);
   return out;
+}
+
+std::optional<double> bandOnset(const std::vector<Record>& records) {
+  std::optional<double> onset;
+  for (auto r = records.rbegin(); r != records.rend() && std::isfinite(r->bandInclinationDeg); ++r) onset = r->eps1;
+  return onset;
 }
 
 Json microJson(const Record& r, const std::vector<std::string>& names) {

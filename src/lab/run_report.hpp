@@ -45,6 +45,10 @@ struct ShearReport {
 };
 ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Laboratory& lab, Json& summary);
 
+// The shear band's onset: eps1 of the first record from which every record to the end has a band
+// (Record::bandInclinationDeg finite); null when the last record has none.
+std::optional<double> bandOnset(const std::vector<Record>& records);
+
 // The micromechanics columns of one record by name, null where not measurable, with its energy
 // residual and eps1.
 Json microJson(const Record& r, const std::vector<std::string>& names);

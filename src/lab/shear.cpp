@@ -70,6 +70,9 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.rotationMeanDeg = k.rotationMeanDeg;
   r.rotationBandMeanDeg = k.rotationBandMeanDeg;
   r.bandFraction = k.bandFraction;
+  const std::optional<ShearBand> band = shearBand(k);
+  r.bandInclinationDeg = band ? band->inclinationDeg : std::nan("");
+  r.bandThicknessD50 = band ? band->thickness / d50_ : std::nan("");
   r.kinetic = kineticEnergy(sim_);
   r.elastic = elasticEnergy(sim_);
   r.workBoundary = sim_.energy.boundaryWork;

@@ -57,3 +57,15 @@ def test_vtk_snapshots_read_back(grainlab, data_dir, tmp_path):
     assert abs(0.5 * (stress[0] + stress[1]) / float(last["sigma2"]) - 1.0) < 0.05
     assert stress[4] > 1.5 * stress[0]
     assert summary["status"] == "completed"
+
+
+def test_band_slice_plot(grainlab, data_dir, tmp_path):
+    """plots/band_slice.png: a slice of the last snapshot's local shear strain, with the band's trace or
+    the statement that none was found (the summary's shear_band)."""
+    out = tmp_path / "run"
+    grainlab("run", os.path.join(data_dir, "small-triaxial.toml"), "--out", str(out), "--quiet",
+             "--set", "sample.n_particles=100", "--set", "test.final_axial_strain=0.01",
+             "--set", "output.vtk_every_strain=0.01", "--set", "output.plots=true", check=0)
+    summary = json.loads((out / "summary.json").read_text())
+    assert "shear_band" in summary and "shear_band_onset_eps1" in summary
+    assert (out / "plots" / "band_slice.png").stat().st_size > 1000

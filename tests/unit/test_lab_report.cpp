@@ -140,3 +140,22 @@ TEST(RunReport, MicroColumnsNullWhereNotMeasured) {
   EXPECT_TRUE(j["energy_residual"].is_null());
   EXPECT_DOUBLE_EQ(j["eps1"].get<double>(), 0.03);
 }
+
+// The band's onset is where it appears for good: a band seen at one record and lost at the next
+// does not count; none at the last record is no onset.
+TEST(RunReport, BandOnsetIsWhereTheBandStaysToTheEnd) {
+  const double none = std::nan("");
+  auto records = [&](std::vector<double> inclination) {
+    std::vector<lab::Record> r(inclination.size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      r[i].eps1 = 0.01 * static_cast<double>(i);
+      r[i].bandInclinationDeg = inclination[i];
+    }
+    return r;
+  };
+  const auto onset = lab::bandOnset(records({none, 55.0, none, 58.0, 60.0}));
+  ASSERT_TRUE(onset);
+  EXPECT_DOUBLE_EQ(*onset, 0.03);
+  EXPECT_FALSE(lab::bandOnset(records({none, 55.0, 56.0, none})));
+  EXPECT_FALSE(lab::bandOnset({}));
+}
