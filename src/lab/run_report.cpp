@@ -210,19 +210,6 @@ void moduliFromLoops(const RunConfig& config, const std::vector<UnloadReloadLoop
                            : std::string());
 }
 
-// The shear band at the end of the test (lab/shear_band.hpp), null where none is found.
-Json shearBandJson(const std::optional<ShearBand>& b, double d50) {
-  if (!b) return nullptr;
-  return {{"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
-          {"thickness_d50", finite(b->thickness / d50, "shear_band.thickness_d50")},
-          {"normal", {b->normal.x(), b->normal.y(), b->normal.z()}},
-          {"centre", {b->centre.x(), b->centre.y(), b->centre.z()}},
-          {"grains", b->grains},
-          {"flatness", b->flatness},
-          {"peak_local_strain", b->peakStrain},
-          {"background_local_strain", b->backgroundStrain}};
-}
-
 double inertialMaxOf(const std::vector<Record>& records) {
   double inertialMax = 0.0;
   for (const auto& r : records) inertialMax = std::max(inertialMax, r.inertialNumber);
@@ -333,7 +320,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["rotation_band_mean_deg"] = measured(k.rotationBandMeanDeg);
   s["rotation_outside_band_mean_deg"] = measured(k.rotationOutsideMeanDeg);
   s["band_fraction"] = measured(k.bandFraction);
-  s["shear_band"] = shearBandJson(lab.shearBand(k), lab.d50());
+  s["shear_band"] = shearBandJson(lab.shearBand(k), lab.simulation(), lab.d50());
   const std::optional<double> onset = bandOnset(records);
   s["shear_band_onset_eps1"] = optional(onset);
   s["shear_band_onset_over_peak"] =
@@ -344,7 +331,8 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
       "(smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the centroids of "
       "full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, thickness_d50 "
       "= full width at half height of the mean eq profile across it (bins of d50) above the background (the median "
-      "eq outside); null when any step fails, and in a periodic cell (a band may wrap across the faces); the same at every "
+      "eq outside); void_ratio_inside/outside: the box's volume and the grains' solid (by spherical caps, exact for "
+      "spheres) within and beyond the slab of that thickness; null when any step fails, and in a periodic cell (a band may wrap across the faces); the same at every "
       "record (timeseries band_inclination_deg, band_thickness_d50); shear_band_onset_eps1 = the first record "
       "from which every record to the end has a band, shear_band_onset_over_peak = that over eps1_at_peak";
   // I = rate d50 sqrt(rho/p) with the p measured at each record.
@@ -557,6 +545,22 @@ ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Labor
   else
     reportReversing(config, shear, lab, summary);
   return out;
+}
+
+Json shearBandJson(const std::optional<ShearBand>& b, const Simulation& sim, double d50) {
+  if (!b) return nullptr;
+  const std::optional<BandVoidRatios> e = bandVoidRatios(*b, sim.particles.position, sim.particles.semiAxes,
+                                                          sim.box.lowerCorner(), sim.box.upperCorner());
+  return {{"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
+          {"void_ratio_inside", e ? Json(finite(e->inside, "shear_band.void_ratio_inside")) : Json(nullptr)},
+          {"void_ratio_outside", e ? Json(finite(e->outside, "shear_band.void_ratio_outside")) : Json(nullptr)},
+          {"thickness_d50", finite(b->thickness / d50, "shear_band.thickness_d50")},
+          {"normal", {b->normal.x(), b->normal.y(), b->normal.z()}},
+          {"centre", {b->centre.x(), b->centre.y(), b->centre.z()}},
+          {"grains", b->grains},
+          {"flatness", b->flatness},
+          {"peak_local_strain", b->peakStrain},
+          {"background_local_strain", b->backgroundStrain}};
 }
 
 std::optional<double> bandOnset(const std::vector<Record>& records) {

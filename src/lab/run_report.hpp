@@ -16,6 +16,7 @@
 #include "lab/macro.hpp"
 #include "lab/moduli.hpp"
 #include "lab/protocols.hpp"
+#include "lab/shear_band.hpp"
 
 namespace grainlab::lab {
 
@@ -44,6 +45,10 @@ struct ShearReport {
   bool simpleShear = false;  // stressDilatancy's strain is gamma and it has no principal ratio
 };
 ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Laboratory& lab, Json& summary);
+
+// summary.json's shear_band: the band's plane, thickness in d50 and the void ratios inside and
+// outside it in the wall box of `sim`; null without a band.
+Json shearBandJson(const std::optional<ShearBand>& band, const Simulation& sim, double d50);
 
 // The shear band's onset: eps1 of the first record from which every record to the end has a band
 // (Record::bandInclinationDeg finite); null when the last record has none.

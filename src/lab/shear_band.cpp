@@ -159,4 +159,37 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
   return b;
 }
 
+std::optional<BandVoidRatios> bandVoidRatios(const ShearBand& band, const std::vector<Vec3>& position,
+                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi) {
+  if (position.size() != semiAxes.size() || !(band.thickness > 0.0) || !((hi - lo).minCoeff() > 0.0))
+    return std::nullopt;
+  const double h = 0.5 * band.thickness;
+  // The volume of a sphere of radius r below a plane at height t above its lowest point.
+  auto below = [](double r, double t) {
+    t = std::clamp(t, 0.0, 2.0 * r);
+    return kPi * t * t * (3.0 * r - t) / 3.0;
+  };
+  double solidIn = 0.0, solid = 0.0;
+  for (std::size_t i = 0; i < position.size(); ++i) {
+    const Vec3& a = semiAxes[i];
+    const double r = std::cbrt(a[0] * a[1] * a[2]);
+    const double s = band.normal.dot(position[i] - band.centre);
+    solid += 4.0 / 3.0 * kPi * a[0] * a[1] * a[2];
+    solidIn += below(r, h - (s - r)) - below(r, -h - (s - r));
+  }
+  constexpr int kGrid = 128;
+  const Vec3 step = (hi - lo) / kGrid;
+  long inside = 0;
+  for (int i = 0; i < kGrid; ++i)
+    for (int j = 0; j < kGrid; ++j)
+      for (int k = 0; k < kGrid; ++k) {
+        const Vec3 x = lo + Vec3((i + 0.5) * step.x(), (j + 0.5) * step.y(), (k + 0.5) * step.z());
+        inside += std::abs(band.normal.dot(x - band.centre)) <= h;
+      }
+  const double volume = (hi - lo).prod();
+  const double slab = volume * static_cast<double>(inside) / (static_cast<double>(kGrid) * kGrid * kGrid);
+  if (!(solidIn > 0.0) || !(solid - solidIn > 0.0)) return std::nullopt;
+  return BandVoidRatios{slab / solidIn - 1.0, (volume - slab) / (solid - solidIn) - 1.0};
+}
+
 }  // namespace grainlab::lab

@@ -52,4 +52,15 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
                                        const std::vector<double>& inBand, const std::vector<char>& active,
                                        const ShearBandSettings& settings);
 
+// The void ratio inside the band (the slab |n.(x - c)| <= thickness/2) and outside it, in the
+// box [lo, hi]. The solid in the slab is exact for spheres (each grain's part between the two
+// planes, by the spherical caps; a non-spherical grain as its volume-equivalent sphere); the slab's
+// volume within the box is integrated on a 128^3 grid of the box. Null where either part holds no
+// solid.
+struct BandVoidRatios {
+  double inside = 0.0, outside = 0.0;
+};
+std::optional<BandVoidRatios> bandVoidRatios(const ShearBand& band, const std::vector<Vec3>& position,
+                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi);
+
 }  // namespace grainlab::lab

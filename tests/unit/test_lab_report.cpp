@@ -159,3 +159,26 @@ TEST(RunReport, BandOnsetIsWhereTheBandStaysToTheEnd) {
   EXPECT_FALSE(lab::bandOnset(records({none, 55.0, 56.0, none})));
   EXPECT_FALSE(lab::bandOnset({}));
 }
+
+// summary.json's shear_band from a band in a wall box of a simple cubic packing: the numbers of the
+// band and the void ratio 6/pi - 1 on both sides; null without a band.
+TEST(RunReport, ShearBandKeys) {
+  Simulation sim;
+  for (int x = 0; x < 12; ++x)
+    for (int y = 0; y < 12; ++y)
+      for (int z = 0; z < 24; ++z) sim.particles.addSphere(Vec3(x + 0.5, y + 0.5, z + 0.5) * 1e-3, 0.5e-3, 2650.0);
+  sim.box.setBounds(Vec3::Zero(), Vec3(12, 12, 24) * 1e-3);
+  lab::ShearBand b;
+  b.normal = Vec3(std::sin(M_PI / 3), 0.0, std::cos(M_PI / 3));
+  b.centre = Vec3(6, 6, 12) * 1e-3;
+  b.inclinationDeg = 60.0;
+  b.thickness = 6e-3;
+  b.grains = 900;
+  const lab::Json j = lab::shearBandJson(b, sim, 1e-3);
+  EXPECT_DOUBLE_EQ(j["inclination_deg"].get<double>(), 60.0);
+  EXPECT_DOUBLE_EQ(j["thickness_d50"].get<double>(), 6.0);
+  EXPECT_EQ(j["grains"].get<int>(), 900);
+  EXPECT_NEAR(j["void_ratio_inside"].get<double>(), 6.0 / M_PI - 1.0, 0.03);
+  EXPECT_NEAR(j["void_ratio_outside"].get<double>(), 6.0 / M_PI - 1.0, 0.02);
+  EXPECT_TRUE(lab::shearBandJson(std::nullopt, sim, 1e-3).is_null());
+}

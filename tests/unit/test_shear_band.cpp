@@ -121,3 +121,33 @@ TEST(ShearBand, RattlersAreLeftOut) {
   EXPECT_FALSE(lab::findShearBand(f.position, f.strain, f.inBand, active, settings()));
   EXPECT_TRUE(lab::findShearBand(f.position, f.strain, f.inBand, std::vector<char>(active.size(), 1), settings()));
 }
+
+// Void ratios inside and outside the band against a simple cubic packing, e = 6/pi - 1 = 0.9099
+// for touching spheres; with the spheres inside an inclined slab shrunk to 0.4 of the spacing,
+// e inside = 1/(4/3 pi 0.4^3) - 1 = 2.730 and outside still 0.9099.
+TEST(ShearBand, VoidRatiosInsideAndOutsideTheBand) {
+  lab::ShearBand band;
+  band.normal = inclined(60.0);
+  band.centre = Vec3(12.0, 12.0, 24.0) * kD;
+  band.thickness = 8.0 * kD;
+  std::vector<Vec3> position, axes, small;
+  for (int x = 0; x < 24; ++x)
+    for (int y = 0; y < 24; ++y)
+      for (int z = 0; z < 48; ++z) {
+        const Vec3 p = Vec3(x + 0.5, y + 0.5, z + 0.5) * kD;
+        position.push_back(p);
+        axes.push_back(Vec3::Constant(0.5 * kD));
+        const bool in = std::abs(band.normal.dot(p - band.centre)) <= 0.5 * band.thickness;
+        small.push_back(Vec3::Constant((in ? 0.4 : 0.5) * kD));
+      }
+  const Vec3 lo = Vec3::Zero(), hi = Vec3(24, 24, 48) * kD;
+  const double sc = 6.0 / M_PI - 1.0;
+  const auto uniform = lab::bandVoidRatios(band, position, axes, lo, hi);
+  ASSERT_TRUE(uniform);
+  EXPECT_NEAR(uniform->inside, sc, 0.02);
+  EXPECT_NEAR(uniform->outside, sc, 0.01);
+  const auto loose = lab::bandVoidRatios(band, position, small, lo, hi);
+  ASSERT_TRUE(loose);
+  EXPECT_NEAR(loose->inside, 1.0 / (4.0 / 3.0 * M_PI * 0.064) - 1.0, 0.12);
+  EXPECT_NEAR(loose->outside, sc, 0.03);
+}
