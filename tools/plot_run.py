@@ -142,7 +142,35 @@ def main(directory):
         save(fig, os.path.join(out, "energy.png"))
     laboratory_plots(data, summary, out, title)
     band_slice(directory, summary, out, title)
+    rotation_plot(data, eps1, strain_name, out, title)
     return 0
+
+
+def rotation_plot(data, eps1, strain_name, out, title):
+    """plots/rotation.png: the mean grain rotation inside and outside the shear band against the
+    strain, each with its spread (mean +- standard deviation), as [R]'s Fig. 2 plots the band's."""
+    needed = ("rotation_band_mean_deg", "rotation_outside_band_mean_deg", "rotation_band_std_deg",
+              "rotation_outside_band_std_deg")
+    if not all(k in data for k in needed):
+        return
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot(eps1, data["rotation_mean_deg"], color="0.4", lw=0.8, label="all load-bearing grains")
+    for key, std, colour, label in (("rotation_band_mean_deg", "rotation_band_std_deg", "C3", "inside the band"),
+                                    ("rotation_outside_band_mean_deg", "rotation_outside_band_std_deg", "C0",
+                                     "outside the band")):
+        mean = data[key]
+        lo = [m - s for m, s in zip(mean, data[std])]
+        hi = [m + s for m, s in zip(mean, data[std])]
+        ax.plot(eps1, mean, color=colour, lw=1.2, label=label + " (mean +- std)")
+        ax.fill_between(eps1, lo, hi, color=colour, alpha=0.15, lw=0)
+    ax.set_xlabel(strain_name)
+    ax.set_ylabel("grain rotation since the start [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("in the band: local eq >= band_factor x the sample's (empty where no grain is)", fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    save(fig, os.path.join(out, "rotation.png"))
 
 
 def band_slice(directory, summary, out, title):

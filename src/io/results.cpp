@@ -60,7 +60,8 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
       "step,time,eps1,eps_v,sigma1,sigma2,sigma3,q,p,e,phi_deg,Z,unbalanced,eps2,eps3,"
       "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
       "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction,"
-      "band_inclination_deg,band_thickness_d50";
+      "band_inclination_deg,band_thickness_d50,rotation_outside_band_mean_deg,rotation_band_std_deg,"
+      "rotation_outside_band_std_deg";
   if (columns.periodic) s += ",eps1_log,stress_skew";
   if (columns.simpleShear) s += ",gamma,tau";
   if (columns.trueTriaxial) s += ",b";
@@ -90,7 +91,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
     // The rotation means, the band fraction and the band's plane: an empty field where not measured
     // (lab/kinematics.hpp, lab/shear_band.hpp).
     for (double v : {r.rotationMeanDeg, r.rotationBandMeanDeg, r.bandFraction, r.bandInclinationDeg,
-                     r.bandThicknessD50})
+                     r.bandThicknessD50, r.rotationOutsideMeanDeg, r.rotationBandStdDeg, r.rotationOutsideStdDeg})
       s += std::isfinite(v) ? fmt::format(",{:.10g}", v) : std::string(",");
     if (columns.periodic) {
       put(r.step, r.eps1Log);

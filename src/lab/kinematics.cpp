@@ -122,6 +122,17 @@ GrainKinematics grainKinematics(const Simulation& sim, const GrainRecords& recor
   k.rotationBandMeanDeg = classified && band ? sumBand / band : none;
   k.rotationOutsideMeanDeg = classified && counted > band ? sumOut / (counted - band) : none;
   k.bandFraction = classified ? static_cast<double>(band) / counted : none;
+  // The spread of the rotations about each mean (population standard deviation; NaN below two grains).
+  double squaresBand = 0.0, squaresOut = 0.0;
+  for (std::size_t i = 0; i < n && classified; ++i) {
+    if (!active.empty() && !active[i]) continue;
+    if (k.inBand[i] > 0.5)
+      squaresBand += (k.rotationDeg[i] - k.rotationBandMeanDeg) * (k.rotationDeg[i] - k.rotationBandMeanDeg);
+    else
+      squaresOut += (k.rotationDeg[i] - k.rotationOutsideMeanDeg) * (k.rotationDeg[i] - k.rotationOutsideMeanDeg);
+  }
+  k.rotationBandStdDeg = classified && band >= 2 ? std::sqrt(squaresBand / band) : none;
+  k.rotationOutsideStdDeg = classified && counted - band >= 2 ? std::sqrt(squaresOut / (counted - band)) : none;
   return k;
 }
 

@@ -34,6 +34,9 @@ struct GrainKinematics {
   double rotationBandMeanDeg = 0.0;
   double rotationOutsideMeanDeg = 0.0;
   double bandFraction = 0.0;
+  // The population standard deviation of the rotations inside and outside the band (NaN below two
+  // grains, and while there is no band criterion).
+  double rotationBandStdDeg = 0.0, rotationOutsideStdDeg = 0.0;
 };
 
 // Equivalent shear strain sqrt(2/3 e:e) of the deviator of a strain tensor.

@@ -48,6 +48,7 @@ struct Record {
   double sigma1Now = 0.0, sigma2Now = 0.0, sigma3Now = 0.0;
   double sigma1Unbalanced = 0.0, sigma2Unbalanced = 0.0, sigma3Unbalanced = 0.0;
   double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
+  double rotationOutsideMeanDeg = 0.0, rotationBandStdDeg = 0.0, rotationOutsideStdDeg = 0.0;  // NaN: not measured
   // The shear band's plane at the record (lab/shear_band.hpp): NaN where none is found.
   double bandInclinationDeg = 0.0, bandThicknessD50 = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,

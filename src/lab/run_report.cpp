@@ -320,6 +320,8 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["rotation_band_mean_deg"] = measured(k.rotationBandMeanDeg);
   s["rotation_outside_band_mean_deg"] = measured(k.rotationOutsideMeanDeg);
   s["band_fraction"] = measured(k.bandFraction);
+  s["rotation_band_std_deg"] = measured(k.rotationBandStdDeg);
+  s["rotation_outside_band_std_deg"] = measured(k.rotationOutsideStdDeg);
   s["shear_band"] = shearBandJson(lab.shearBand(k), lab.simulation(), lab.d50());
   const std::optional<double> onset = bandOnset(records);
   s["shear_band_onset_eps1"] = optional(onset);

@@ -70,6 +70,9 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.rotationMeanDeg = k.rotationMeanDeg;
   r.rotationBandMeanDeg = k.rotationBandMeanDeg;
   r.bandFraction = k.bandFraction;
+  r.rotationOutsideMeanDeg = k.rotationOutsideMeanDeg;
+  r.rotationBandStdDeg = k.rotationBandStdDeg;
+  r.rotationOutsideStdDeg = k.rotationOutsideStdDeg;
   const std::optional<ShearBand> band = shearBand(k);
   r.bandInclinationDeg = band ? band->inclinationDeg : std::nan("");
   r.bandThicknessD50 = band ? band->thickness / d50_ : std::nan("");

@@ -190,4 +190,21 @@ TEST(Kinematics, ShearBandIsDetected) {
   EXPECT_FALSE(std::isnan(strict.rotationOutsideMeanDeg));
   const lab::GrainKinematics loose = lab::grainKinematics(sim, records, box, 4.5e-3, 1.2);
   EXPECT_GE(loose.bandFraction, k.bandFraction);
+
+  // The spread of the rotations: the band's grains turned by 10 and 20 deg alternately (a fraction q
+  // by 20: mean 10 + 10 q, standard deviation 10 sqrt(q (1 - q))), the others not at all (0, 0).
+  std::size_t inBand = 0, by20 = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (k.inBand[i] < 0.5) continue;
+    const double deg = inBand++ % 2 ? 20.0 : 10.0;
+    by20 += deg == 20.0;
+    p.orientation[i] = Quat(Eigen::AngleAxisd(degToRad(deg), Vec3::UnitY())) * p.orientation[i];
+  }
+  const lab::GrainKinematics turned = lab::grainKinematics(sim, records, box, 4.5e-3);
+  const double q = static_cast<double>(by20) / static_cast<double>(inBand);
+  EXPECT_NEAR(turned.rotationBandMeanDeg, 10.0 + 10.0 * q, 1e-9);
+  EXPECT_NEAR(turned.rotationBandStdDeg, 10.0 * std::sqrt(q * (1.0 - q)), 1e-9);
+  EXPECT_NEAR(turned.rotationOutsideMeanDeg, 0.0, 1e-9);
+  EXPECT_NEAR(turned.rotationOutsideStdDeg, 0.0, 1e-9);
+  EXPECT_TRUE(std::isnan(strict.rotationBandStdDeg));  // below two grains
 }
