@@ -15,6 +15,23 @@ double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
 }
+
+// The least-squares plane through points: their centroid and the eigen-decomposition of their
+// covariance (eigenvalues increasing; the first eigenvector is the plane's normal).
+struct PlaneFit {
+  Vec3 centre;
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  bool ok() const { return eig.info() == Eigen::Success && eig.eigenvalues()(1) > 0.0; }
+};
+PlaneFit fitPlane(const std::vector<Vec3>& points) {
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& x : points) centre += x;
+  centre /= static_cast<double>(points.size());
+  Mat3 cov = Mat3::Zero();
+  for (const Vec3& x : points) cov += (x - centre) * (x - centre).transpose();
+  cov /= static_cast<double>(points.size());
+  return {centre, Eigen::SelfAdjointEigenSolver<Mat3>(cov)};
+}
 }  // namespace
 
 std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const std::vector<double>& strain,
@@ -43,39 +60,32 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
     return std::nullopt;
 
   // 2. The plane: centroid and covariance of the flagged grains.
-  Vec3 centre = Vec3::Zero();
-  for (std::size_t i : band) centre += position[i];
-  centre /= static_cast<double>(band.size());
-  Mat3 cov = Mat3::Zero();
-  for (std::size_t i : band) {
-    const Vec3 d = position[i] - centre;
-    cov += d * d.transpose();
-  }
-  cov /= static_cast<double>(band.size());
-  const Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);  // eigenvalues in increasing order
-  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(1) > 0.0)) return std::nullopt;
+  std::vector<Vec3> flagged;
+  for (std::size_t i : band) flagged.push_back(position[i]);
+  const PlaneFit guess = fitPlane(flagged);
+  if (!guess.ok()) return std::nullopt;
+  Vec3 centre = guess.centre;
   ShearBand b;
-  b.flatness = eig.eigenvalues()(0) / eig.eigenvalues()(1);
+  b.flatness = guess.eig.eigenvalues()(0) / guess.eig.eigenvalues()(1);
   if (!(b.flatness <= settings.maxFlatness)) return std::nullopt;
   // The covariance's normal is biased where the boundary clips the band obliquely (a slab cut by
   // vertical walls is a parallelogram, whose thickness and length directions correlate). The
   // mid-plane is refined from the band's local mid-points instead: the flagged grains are binned in
   // columns along the normal (2 bin widths square in the plane), each full column's centroid lies
   // on the mid-plane, and a plane fitted to those centroids gives the next normal. Columns with
-  // fewer than half the median count (clipped at the boundary) are left out.
-  Vec3 normal = eig.eigenvectors().col(0).normalized();
+  // fewer than 0.85 of the median count (clipped at the boundary) are left out.
+  Vec3 normal = guess.eig.eigenvectors().col(0).normalized();
   for (int iteration = 0; iteration < 30; ++iteration) {
     const Vec3 e1 = (std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(normal).normalized();
     const Vec3 e2 = normal.cross(e1);
     const double h = 2.0 * settings.binWidth;
     std::map<std::pair<long, long>, std::pair<Vec3, std::size_t>> columns;
-    for (std::size_t i : band) {
-      const Vec3 d = position[i] - centre;
+    for (const Vec3& x : flagged) {
+      const Vec3 d = x - centre;
       const std::pair<long, long> key{static_cast<long>(std::floor(e1.dot(d) / h)),
                                       static_cast<long>(std::floor(e2.dot(d) / h))};
-      auto [it, fresh] = columns.try_emplace(key, Vec3::Zero(), std::size_t{0});
-      auto& c = it->second;
-      c.first += position[i];
+      auto& c = columns.try_emplace(key, Vec3::Zero(), std::size_t{0}).first->second;
+      c.first += x;
       ++c.second;
     }
     std::vector<double> sizes;
@@ -85,18 +95,13 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
     for (const auto& [key, c] : columns)
       if (static_cast<double>(c.second) >= least) mid.push_back(c.first / static_cast<double>(c.second));
     if (mid.size() < 3) break;
-    Vec3 m = Vec3::Zero();
-    for (const Vec3& x : mid) m += x;
-    m /= static_cast<double>(mid.size());
-    Mat3 cm = Mat3::Zero();
-    for (const Vec3& x : mid) cm += (x - m) * (x - m).transpose();
-    const Eigen::SelfAdjointEigenSolver<Mat3> plane(cm);
-    if (plane.info() != Eigen::Success || !(plane.eigenvalues()(1) > 0.0)) break;
-    Vec3 next = plane.eigenvectors().col(0).normalized();
+    const PlaneFit plane = fitPlane(mid);
+    if (!plane.ok()) break;
+    Vec3 next = plane.eig.eigenvectors().col(0).normalized();
     if (next.dot(normal) < 0.0) next = -next;
     const bool converged = next.dot(normal) > 1.0 - 1e-12;
     normal = next;
-    centre = m;
+    centre = plane.centre;
     if (converged) break;
   }
   b.normal = normal.z() < 0.0 ? Vec3(-normal) : normal;
