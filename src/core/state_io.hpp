@@ -10,7 +10,10 @@
 //   - bool, as one byte that must read back as 0 or 1;
 //   - Eigen's Vec3 and Quat, component by component (they are not trivially copyable);
 //   - contact::ContactHistory, field by field (it holds Vec3s);
-//   - std::array and std::vector of any of these (a vector as a 64-bit count, then the elements).
+//   - std::array and std::vector of any of these (a vector as a 64-bit count, then the elements);
+//   - structs that list their fields (`Listed`: a static `fields(self)` returning std::tie of every
+//     field, in the order of the bytes), field by field through that one list, so writing and
+//     reading cannot disagree and a field added without listing it does not compile.
 // Reading is bounded: loadState reads from a MemoryInput, and every count is checked against the
 // bytes left before anything is allocated.
 #include <array>
@@ -20,6 +23,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <streambuf>
+#include <tuple>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -220,6 +224,36 @@ void getVector(std::istream& in, std::vector<T>& v) {
   } else {
     for (T& e : v) get(in, e);
   }
+}
+
+// A struct that names its fields once, for writing and reading: `static auto fields(Self& s)`
+// returns std::tie(s.a, s.b, ...) of every field (Self const or not).
+template <class T>
+concept Listed = !Bytewise<T> && requires(T& v, const T& c) {
+  T::fields(v);
+  T::fields(c);
+};
+
+template <class T>
+void put(std::ostream& out, const std::vector<T>& v) {
+  putVector(out, v);
+}
+template <class T>
+void get(std::istream& in, std::vector<T>& v) {
+  getVector(in, v);
+}
+
+template <Listed T>
+void put(std::ostream& out, const T& value) {
+  static_assert(fieldCount<T>() == std::tuple_size_v<decltype(T::fields(value))>,
+                "list every field of the struct in its fields()");
+  std::apply([&out](const auto&... field) { (put(out, field), ...); }, T::fields(value));
+}
+template <Listed T>
+void get(std::istream& in, T& value) {
+  static_assert(fieldCount<T>() == std::tuple_size_v<decltype(T::fields(value))>,
+                "list every field of the struct in its fields()");
+  std::apply([&in](auto&... field) { (get(in, field), ...); }, T::fields(value));
 }
 
 }  // namespace grainlab::stateio

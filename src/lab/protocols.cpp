@@ -272,38 +272,14 @@ std::optional<ShearBand> Laboratory::shearBand(const GrainKinematics& k) const {
   return findShearBand(sim_.particles.position, k.localShearStrain, k.inBand, k.active, settings);
 }
 
+std::size_t Laboratory::shearStateFieldCount() { return stateio::fieldCount<ShearState>(); }
+
 void Laboratory::saveState(std::ostream& out) const {
   using namespace stateio;
   sim_.saveState(out);
   records_.saveState(out);
   put(out, d50_);
-  const ShearState& st = shear_;
-  put(out, st.started);
-  put(out, st.h0);
-  put(out, st.v0);
-  put(out, st.l0);
-  put(out, st.rampSteps);
-  put(out, st.startStep);
-  put(out, st.nextRecord);
-  put(out, st.nextSnapshot);
-  put(out, st.nextCheckpoint);
-  put(out, st.stressSum);
-  put(out, st.shearStressSum);
-  put(out, st.wallStressSum);
-  put(out, st.stressSamples);
-  put(out, st.elastic0);
-  put(out, st.kinetic0);
-  put(out, st.result.strainRate);
-  put(out, st.result.inertialNumber);
-  put(out, st.result.maxLateralDeviation);
-  put(out, st.result.maxSingleWallDeviation);
-  putVector(out, st.result.records);
-  put(out, st.loopNext);
-  put(out, st.loopPhase);
-  put(out, st.loopQ);
-  put(out, st.loopEndStep);
-  put(out, st.loopRestStart);
-  put(out, st.slowdown);
+  put(out, shear_);
   put(out, protocol_ != nullptr);
   if (protocol_) {
     // Padding written as zeros (stateio::putFields), the layout the loader reads.
@@ -322,33 +298,8 @@ void Laboratory::loadState(std::istream& in) {
   sim_.loadState(in);
   records_.loadState(in);
   get(in, d50_);
-  ShearState& st = shear_;
-  get(in, st.started);
-  get(in, st.h0);
-  get(in, st.v0);
-  get(in, st.l0);
-  get(in, st.rampSteps);
-  get(in, st.startStep);
-  get(in, st.nextRecord);
-  get(in, st.nextSnapshot);
-  get(in, st.nextCheckpoint);
-  get(in, st.stressSum);
-  get(in, st.shearStressSum);
-  get(in, st.wallStressSum);
-  get(in, st.stressSamples);
-  get(in, st.elastic0);
-  get(in, st.kinetic0);
-  get(in, st.result.strainRate);
-  get(in, st.result.inertialNumber);
-  get(in, st.result.maxLateralDeviation);
-  get(in, st.result.maxSingleWallDeviation);
-  getVector(in, st.result.records);
-  get(in, st.loopNext);
-  get(in, st.loopPhase);
-  get(in, st.loopQ);
-  get(in, st.loopEndStep);
-  get(in, st.loopRestStart);
-  get(in, st.slowdown);
+  get(in, shear_);
+  const ShearState& st = shear_;
   bool hasProtocol = false;
   get(in, hasProtocol);
   if (hasProtocol != st.started) throw std::runtime_error("inconsistent state: a shearing protocol's state without shearing, or none with it");

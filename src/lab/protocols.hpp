@@ -9,6 +9,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/pipeline.hpp"
@@ -162,6 +163,11 @@ struct ShearResult {
   double maxLateralDeviation = 0.0;     // max |sigma_lat - target|/p, lateral stress = mean of two walls
   double maxSingleWallDeviation = 0.0;  // the same for the worst single lateral wall (wall box)
   long steps = 0;
+  // Every field, in the order a checkpoint holds them (stateio::Listed).
+  template <class Self>
+  static auto fields(Self& s) {
+    return std::tie(s.records, s.strainRate, s.inertialNumber, s.maxLateralDeviation, s.maxSingleWallDeviation, s.steps);
+  }
 };
 
 class Laboratory {
@@ -281,7 +287,22 @@ class Laboratory {
     long loopRestStart = -1;   // the step a rest before an unload began (test.loop_rest)
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
+    // Every field, in the order a checkpoint holds them (stateio::Listed): one list for saveState
+    // and loadState, checked against the struct's field count at compile time.
+    template <class Self>
+    static auto fields(Self& s) {
+      return std::tie(s.started, s.h0, s.v0, s.l0, s.rampSteps, s.startStep, s.nextRecord, s.nextSnapshot,
+                      s.nextCheckpoint, s.stressSum, s.shearStressSum, s.wallStressSum, s.stressSamples, s.elastic0,
+                      s.kinetic0, s.result, s.loopNext, s.loopPhase, s.loopQ, s.loopEndStep, s.loopRestStart,
+                      s.forceRecord, s.slowdown);
+    }
   };
+
+ public:
+  // Fields of the shearing state a checkpoint holds (for the checkpoint's layout tag).
+  static std::size_t shearStateFieldCount();
+
+ private:
  public:
   // The shearing protocol of the test (null before beginShear) and the boundary's controls.
   const ShearProtocol* protocol() const { return protocol_.get(); }

@@ -283,6 +283,64 @@ TEST(StateIo, VectorsOfEigenTypesAreWrittenByComponents) {
 
 namespace {
 
+// A struct that lists its fields (stateio::Listed), with a nested one, a vector and Eigen values.
+struct ListedInner {
+  std::vector<double> values;
+  long count = 0;
+  template <class Self>
+  static auto fields(Self& s) {
+    return std::tie(s.values, s.count);
+  }
+};
+struct ListedOuter {
+  bool flag = false;
+  Vec3 position = Vec3::Zero();
+  ListedInner inner;
+  int phase = 0;
+  template <class Self>
+  static auto fields(Self& s) {
+    return std::tie(s.flag, s.position, s.inner, s.phase);
+  }
+};
+static_assert(stateio::Listed<ListedOuter> && stateio::Listed<ListedInner> && !stateio::Listed<Wall>);
+
+}  // namespace
+
+// One list writes and reads every field, in the listed order and without padding.
+TEST(StateIo, ListedStructsAreWrittenFieldByFieldInTheirOrder) {
+  ListedOuter a;
+  a.flag = true;
+  a.position = Vec3(1.5, -2.0, 4.0);
+  a.inner.values = {0.25, -8.0};
+  a.inner.count = 7;
+  a.phase = -3;
+  std::ostringstream out(std::ios::binary);
+  stateio::put(out, a);
+  const std::string bytes = out.str();
+  ASSERT_EQ(bytes.size(), 1 + 24 + (8 + 16) + 8 + 4u);
+  double y;
+  std::memcpy(&y, bytes.data() + 1 + 8, sizeof(double));
+  EXPECT_EQ(y, -2.0);
+  long count;
+  std::memcpy(&count, bytes.data() + 1 + 24 + 24, sizeof(long));
+  EXPECT_EQ(count, 7);
+  stateio::MemoryInput in(bytes);
+  ListedOuter b;
+  stateio::get(in, b);
+  EXPECT_EQ(in.bytesLeft(), 0u);
+  EXPECT_TRUE(b.flag);
+  EXPECT_EQ(b.position, a.position);
+  EXPECT_EQ(b.inner.values, a.inner.values);
+  EXPECT_EQ(b.inner.count, 7);
+  EXPECT_EQ(b.phase, -3);
+  // A short read is an error, not a half-filled struct taken for a whole one.
+  stateio::MemoryInput shortIn(std::string_view(bytes).substr(0, bytes.size() - 2));
+  ListedOuter c;
+  EXPECT_THROW(stateio::get(shortIn, c), stateio::StateError);
+}
+
+namespace {
+
 // Loads the sheared state, lets `spoil` change it, and returns validateState's complaint ("" if none).
 std::string complaint(const std::function<void(Simulation&)>& spoil) {
   lab::Laboratory lab(smallConfig());
