@@ -175,8 +175,10 @@ def rotation_plot(data, eps1, strain_name, out, title):
 
 def band_slice(directory, summary, out, title):
     """plots/band_slice.png: the grains of the last particle snapshot within one d50 of the sample's
-    mid-plane y = const, coloured by their local shear strain, the band's grains outlined, and the
-    trace of the band's plane (summary shear_band) where one was found."""
+    mid-plane y = const, coloured by their local shear strain increment over the last band window
+    (the field the band is found from; the strain since the start of shearing for snapshots without
+    it), the band's grains outlined, and the trace of the band's plane (summary shear_band) where one
+    was found."""
     import glob
     snapshots = sorted(glob.glob(os.path.join(directory, "vtk", "particles_*.vtu")))
     if not snapshots:
@@ -195,15 +197,16 @@ def band_slice(directory, summary, out, title):
     sel = np.abs(y - centre_y) < d50
     if not sel.any():
         return
-    eq = m.point_data["local_shear_strain"].ravel()
-    band = m.point_data["in_band"].ravel() > 0.5
+    incremental = "strain_increment" in m.point_data and "in_band_increment" in m.point_data
+    eq = m.point_data["strain_increment" if incremental else "local_shear_strain"].ravel()
+    band = m.point_data["in_band_increment" if incremental else "in_band"].ravel() > 0.5
     aspect = (z.max() - z.min()) / max(x.max() - x.min(), 1e-300)
     fig, ax = plt.subplots(figsize=(6.4, min(9.0, max(3.5, 4.4 * aspect + 1.4))))
     pts = ax.scatter(1e3 * x[sel], 1e3 * z[sel], c=100.0 * eq[sel], s=12, cmap="viridis")
     ax.scatter(1e3 * x[sel & band], 1e3 * z[sel & band], s=22, facecolors="none", edgecolors="r", lw=0.6,
                label="in the band (eq >= band_factor x the sample's)")
     sb = summary.get("shear_band")
-    if sb:
+    if sb and sb.get("detected", True) and sb.get("normal"):
         n, c = np.array(sb["normal"]), np.array(sb["centre"])
         # The plane n.(p - c) = 0 in the slice y = centre_y, drawn across the sample's x range.
         if abs(n[2]) > 1e-9:
@@ -213,9 +216,12 @@ def band_slice(directory, summary, out, title):
                     label=f"band: {sb['inclination_deg']:.1f} deg, {sb['thickness_d50']:.1f} d50 thick")
         else:
             ax.axvline(1e3 * c[0], color="r", ls="--", lw=1.0, label="band: vertical")
+    elif sb and sb.get("detected") is False:
+        ax.set_title("no shear band found in the last strain window (shear_band.detected = false)", fontsize=9)
     else:
-        ax.set_title("no shear band found (summary shear_band = null)", fontsize=9)
-    fig.colorbar(pts, ax=ax, shrink=0.8, label="local shear strain eq since\nthe start of shearing [%]")
+        ax.set_title("shear band not looked for (shear_band.detected = null)", fontsize=9)
+    fig.colorbar(pts, ax=ax, shrink=0.8, label=("local shear strain increment eq\nover the last band window [%]"
+                                                if incremental else "local shear strain eq since\nthe start of shearing [%]"))
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("z [mm]")
     ax.set_aspect("equal")

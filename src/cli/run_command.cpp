@@ -225,6 +225,7 @@ class RunSession {
   // Per-grain fields of the laboratory's records for the particle snapshots.
   io::PointFields grainFields() const {
     const lab::GrainKinematics k = lab_.currentKinematics();
+    const lab::GrainKinematics increment = lab_.incrementKinematics();
     const lab::GrainRecords& rec = lab_.grainRecords();
     std::vector<double> path(rec.rotationPath.size());
     for (std::size_t i = 0; i < path.size(); ++i) path[i] = radToDeg(rec.rotationPath[i]);
@@ -232,7 +233,9 @@ class RunSession {
              {"rotation_path_deg", path},
              {"sphericity", rec.sphericity},
              {"local_shear_strain", k.localShearStrain},
-             {"in_band", k.inBand}},
+             {"in_band", k.inBand},
+             {"strain_increment", increment.localShearStrain},
+             {"in_band_increment", increment.inBand}},
             {{"displacement", k.displacement}}};
   }
   void snapshot(const Simulation& s, double eps1) {

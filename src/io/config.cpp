@@ -210,7 +210,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
       {"output",
        {"dir", "record_every_strain", "plots", "save_packing", "checkpoint_every", "vtk_every_strain",
-        "micro_snapshots", "band_factor"}},
+        "micro_snapshots", "band_factor", "band_strain_window"}},
       {"sample.grading", {"type", "diameters", "passing", "d_min", "d_max", "file"}},
       {"sample.shape", {"type", "elongation", "flatness", "orientation", "fraction", "eccentricity_step"}},
       {"contact.sphericity", {"file", "c", "k", "combine"}},
@@ -1122,6 +1122,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.output.bandFactor = o.number("band_factor", c.output.bandFactor, 1.0, 100.0, true, false,
                                  "must be in (1, 100] (a grain is in the shear band when its local shear strain "
                                  "is at least this times the box's)");
+  c.output.bandStrainWindow = o.number("band_strain_window", c.output.bandStrainWindow, 0.0, 0.5, true, false,
+                                       "must be in (0, 0.5] (the strain window, in the test's driving strain, "
+                                       "whose increment the shear band is measured from)");
   o.finish();
   // Cross-key checks, after every key of every section is known and in range.
   if (c.sample.method == "lattice" && c.sample.packing.empty()) {
@@ -1271,6 +1274,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(output, "output", "micro_snapshots", c.output.microSnapshots);
   put(output, "output", "checkpoint_every", c.output.checkpointEvery);
   put(output, "output", "band_factor", c.output.bandFactor);
+  put(output, "output", "band_strain_window", c.output.bandStrainWindow);
   return toml::table{{"sample", sample}, {"contact", contact}, {"test", test},
                      {"solver", solver}, {"output", output}};
 }

@@ -61,7 +61,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
       "inertial_number,sigma1_contact,sigma2_contact,sigma3_contact,E_kinetic,E_elastic,"
       "W_boundary,D_slip,D_roll,D_damping,rotation_mean_deg,rotation_band_mean_deg,band_fraction,"
       "band_inclination_deg,band_thickness_d50,rotation_outside_band_mean_deg,rotation_band_std_deg,"
-      "rotation_outside_band_std_deg";
+      "rotation_outside_band_std_deg,band_measured";
   if (columns.periodic) s += ",eps1_log,stress_skew";
   if (columns.simpleShear) s += ",gamma,tau";
   if (columns.trueTriaxial) s += ",b";
@@ -93,6 +93,7 @@ std::string timeseriesCsv(const std::vector<lab::Record>& records, const Timeser
     for (double v : {r.rotationMeanDeg, r.rotationBandMeanDeg, r.bandFraction, r.bandInclinationDeg,
                      r.bandThicknessD50, r.rotationOutsideMeanDeg, r.rotationBandStdDeg, r.rotationOutsideStdDeg})
       s += std::isfinite(v) ? fmt::format(",{:.10g}", v) : std::string(",");
+    s += r.bandMeasured != 0.0 ? ",1" : ",0";
     if (columns.periodic) {
       put(r.step, r.eps1Log);
       put(r.step, r.stressSkew);

@@ -77,6 +77,8 @@ Laboratory::Laboratory(const Laboratory& o)
       shear_(o.shear_),
       sim_(o.sim_),
       records_(o.records_),
+      window_(o.window_),
+      previousWindow_(o.previousWindow_),
       micro_(o.micro_),
       microColumns_(o.microColumns_),
       d50_(o.d50_),
@@ -240,15 +242,26 @@ std::vector<double> assignRollingFriction(const RunConfig& c, Particles& particl
 
 GrainKinematics Laboratory::currentKinematics() const {
   // Before shearing the reference is the current state.
-  GrainRecords reference = records_;
-  if (!shear_.started) reference.reset(sim_);
+  if (!shear_.started) {
+    GrainRecords reference = records_;
+    reference.reset(sim_);
+    return kinematicsSince(reference, sampleLengths(sim_));
+  }
+  return kinematicsSince(records_, shear_.l0);
+}
+
+GrainKinematics Laboratory::incrementKinematics() const {
+  if (!shear_.started) return currentKinematics();
+  return kinematicsSince(previousWindow_, shear_.previousWindowLengths);
+}
+
+GrainKinematics Laboratory::kinematicsSince(const GrainRecords& reference, const Vec3& l0) const {
   // The sample's homogeneous Green–Lagrange strain since the reference: from the box lengths, or
   // from the cell, F = H H_ref^-1.
   Mat3 f = Mat3::Identity();
   if (sim_.boundary == Boundary::Periodic) {
     f = sim_.cell.h * reference.referenceCell.inverse();
   } else {
-    const Vec3 l0 = shear_.started ? shear_.l0 : sampleLengths(sim_);
     for (int a = 0; a < 3; ++a) f(a, a) = sim_.box.length(a) / l0[a];
   }
   Mat3 boxStrain = Mat3::Zero();
@@ -265,6 +278,24 @@ GrainKinematics Laboratory::currentKinematics() const {
                          active);
 }
 
+void Laboratory::closeBandWindow(Record& r, double strain) {
+  ShearState& st = shear_;
+  const std::optional<ShearBand> band = shearBand(kinematicsSince(window_, st.windowLengths));
+  r.bandMeasured = 1.0;
+  r.bandInclinationDeg = band ? band->inclinationDeg : std::nan("");
+  r.bandThicknessD50 = band ? band->thickness / d50_ : std::nan("");
+  st.bandFound = band.has_value();
+  st.band = band.value_or(ShearBand{});
+  ++st.bandWindows;
+  previousWindow_ = std::move(window_);
+  st.previousWindowStrain = st.windowStrain;
+  st.previousWindowLengths = st.windowLengths;
+  window_ = records_;
+  window_.reset(sim_);
+  st.windowStrain = strain;
+  for (int a = 0; a < 3; ++a) st.windowLengths[a] = sim_.box.length(a);
+}
+
 std::optional<ShearBand> Laboratory::shearBand(const GrainKinematics& k) const {
   if (sim_.boundary == Boundary::Periodic) return std::nullopt;
   ShearBandSettings settings;
@@ -278,6 +309,8 @@ void Laboratory::saveState(std::ostream& out) const {
   using namespace stateio;
   sim_.saveState(out);
   records_.saveState(out);
+  window_.saveState(out);
+  previousWindow_.saveState(out);
   put(out, d50_);
   put(out, shear_);
   put(out, protocol_ != nullptr);
@@ -297,6 +330,8 @@ void Laboratory::loadState(std::istream& in) {
   using namespace stateio;
   sim_.loadState(in);
   records_.loadState(in);
+  window_.loadState(in);
+  previousWindow_.loadState(in);
   get(in, d50_);
   get(in, shear_);
   const ShearState& st = shear_;
@@ -325,6 +360,15 @@ void Laboratory::loadState(std::istream& in) {
   if (records_.referencePosition.size() != sim_.particles.size() || records_.rotationPath.size() != sim_.particles.size() ||
       records_.referenceOrientation.size() != sim_.particles.size() || records_.sphericity.size() != sim_.particles.size())
     throw std::runtime_error("inconsistent state: grain records do not match the particles");
+  for (const GrainRecords* w : {&window_, &previousWindow_})
+    if (st.started && (w->referencePosition.size() != sim_.particles.size() ||
+                       w->referenceOrientation.size() != sim_.particles.size()))
+      throw std::runtime_error("inconsistent state: the shear band's window records do not match the particles");
+  if (st.started && (st.bandWindows < 0 || !std::isfinite(st.windowStrain) || !std::isfinite(st.previousWindowStrain) ||
+                     st.previousWindowStrain > st.windowStrain ||
+                     !(st.windowLengths.minCoeff() > 0.0 || sim_.boundary == Boundary::Periodic) ||
+                     !(st.previousWindowLengths.minCoeff() > 0.0 || sim_.boundary == Boundary::Periodic)))
+    throw std::runtime_error("inconsistent state: the shear band's strain windows");
   if (!(d50_ > 0.0) || !std::isfinite(d50_)) throw std::runtime_error("inconsistent state: d50 not positive");
 }
 

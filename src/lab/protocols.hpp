@@ -50,8 +50,11 @@ struct Record {
   double sigma1Unbalanced = 0.0, sigma2Unbalanced = 0.0, sigma3Unbalanced = 0.0;
   double rotationMeanDeg = 0.0, rotationBandMeanDeg = 0.0, bandFraction = 0.0;
   double rotationOutsideMeanDeg = 0.0, rotationBandStdDeg = 0.0, rotationOutsideStdDeg = 0.0;  // NaN: not measured
-  // The shear band's plane at the record (lab/shear_band.hpp): NaN where none is found.
+  // The shear band's plane from the strain increment of the window that closes at this record
+  // (output.band_strain_window; bandMeasured 1 there, 0 at the records in between): NaN where no
+  // band is found or none was looked for.
   double bandInclinationDeg = 0.0, bandThicknessD50 = 0.0;
+  double bandMeasured = 0.0;
   double kinetic = 0.0, elastic = 0.0, workBoundary = 0.0, dissipSlip = 0.0, dissipRoll = 0.0,
          dissipDamping = 0.0;
   double workGravity = 0.0;  // work of gravity on the particles [J] (sample.gravity)
@@ -233,6 +236,15 @@ class Laboratory {
   // The shear band of those kinematics (lab/shear_band.hpp, bins of d50); none in a periodic cell,
   // where a band may wrap across the faces.
   std::optional<ShearBand> shearBand(const GrainKinematics& k) const;
+  // The same since the start of the previous band window: the strain increment of the window closed
+  // last and of the part of the current one (the whole test before the first window closes).
+  GrainKinematics incrementKinematics() const;
+  // The band of the last closed window (nullopt: none found there, or no window closed yet:
+  // bandWindows() = 0), from the window's strain increment.
+  std::optional<ShearBand> lastShearBand() const {
+    return shear_.bandFound ? std::optional<ShearBand>(shear_.band) : std::nullopt;
+  }
+  long bandWindows() const { return shear_.bandWindows; }
   static constexpr double kNeighbourhoodDiameters = 2.0;
   static constexpr double kPlatenRampIntegralTimes = 40.0;
   static constexpr double kAutoInertialNumber = 0.98e-3;
@@ -287,6 +299,14 @@ class Laboratory {
     long loopRestStart = -1;   // the step a rest before an unload began (test.loop_rest)
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
+    // The shear band's strain windows (output.band_strain_window): the driving strain and the box
+    // lengths at the start of the current window and of the previous one (their grains in
+    // window_, previousWindow_), the windows closed, and the band of the last one.
+    double windowStrain = 0.0, previousWindowStrain = 0.0;
+    Vec3 windowLengths = Vec3::Zero(), previousWindowLengths = Vec3::Zero();
+    long bandWindows = 0;
+    bool bandFound = false;
+    ShearBand band;
     // Every field, in the order a checkpoint holds them (stateio::Listed): one list for saveState
     // and loadState, checked against the struct's field count at compile time.
     template <class Self>
@@ -294,16 +314,14 @@ class Laboratory {
       return std::tie(s.started, s.h0, s.v0, s.l0, s.rampSteps, s.startStep, s.nextRecord, s.nextSnapshot,
                       s.nextCheckpoint, s.stressSum, s.shearStressSum, s.wallStressSum, s.stressSamples, s.elastic0,
                       s.kinetic0, s.result, s.loopNext, s.loopPhase, s.loopQ, s.loopEndStep, s.loopRestStart,
-                      s.forceRecord, s.slowdown);
+                      s.forceRecord, s.slowdown, s.windowStrain, s.previousWindowStrain, s.windowLengths,
+                      s.previousWindowLengths, s.bandWindows, s.bandFound, s.band);
     }
   };
 
  public:
   // Fields of the shearing state a checkpoint holds (for the checkpoint's layout tag).
   static std::size_t shearStateFieldCount();
-
- private:
- public:
   // The shearing protocol of the test (null before beginShear) and the boundary's controls.
   const ShearProtocol* protocol() const { return protocol_.get(); }
   BoundaryControl& boundary() const { return *boundary_; }
@@ -316,6 +334,11 @@ class Laboratory {
   ShearState shear_;
   Simulation sim_;
   GrainRecords records_;
+  GrainRecords window_, previousWindow_;  // the grains at the start of the current and the previous band window
+  // Kinematics since `reference`, the box lengths then being `lengths` (walls).
+  GrainKinematics kinematicsSince(const GrainRecords& reference, const Vec3& lengths) const;
+  // At a record that closes a band window: the band from the window's increment into r, and the next window.
+  void closeBandWindow(Record& r, double strain);
   MicroAnalyzer micro_;
   MicroColumnSet microColumns_;
   double d50_ = 0.0;

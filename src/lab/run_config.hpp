@@ -240,6 +240,9 @@ struct OutputConfig {
   bool microSnapshots = true;    // contact-network snapshots (micro/) with the VTK ones, analysed at the end
   double checkpointEvery = 0.01;  // checkpoints during shearing, in axial strain; 0 = none
   double bandFactor = 2.0;  // a grain is in the shear band when its local eq >= this x the box's
+  // The shear band is measured from the strain increment over windows of this much of the test's
+  // driving strain (axial, or shear strain), one window closing at the first record past it.
+  double bandStrainWindow = 0.01;
 };
 
 struct RunConfig {

@@ -322,21 +322,23 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   s["band_fraction"] = measured(k.bandFraction);
   s["rotation_band_std_deg"] = measured(k.rotationBandStdDeg);
   s["rotation_outside_band_std_deg"] = measured(k.rotationOutsideStdDeg);
-  s["shear_band"] = shearBandJson(lab.shearBand(k), lab.simulation(), lab.d50());
-  const std::optional<double> onset = bandOnset(records);
-  s["shear_band_onset_eps1"] = optional(onset);
-  s["shear_band_onset_over_peak"] =
-      onset && m.eps1AtPeak > 0.0 ? Json(finite(*onset / m.eps1AtPeak, "shear_band_onset_over_peak")) : Json(nullptr);
-  s["shear_band_method"] =
-      "the load-bearing grains whose local eq since the start of shearing is >= output.band_factor times the "
-      "sample's (band_fraction); a band when they are >= 20 and <= half the load-bearing grains and lie in a slab "
-      "(smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the centroids of "
-      "full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, thickness_d50 "
-      "= full width at half height of the mean eq profile across it (bins of d50) above the background (the median "
-      "eq outside); void_ratio_inside/outside: the box's volume and the grains' solid (by spherical caps, exact for "
-      "spheres) within and beyond the slab of that thickness; null when any step fails, and in a periodic cell (a band may wrap across the faces); the same at every "
-      "record (timeseries band_inclination_deg, band_thickness_d50); shear_band_onset_eps1 = the first record "
-      "from which every record to the end has a band, shear_band_onset_over_peak = that over eps1_at_peak";
+  const bool bandMeasured = lab.bandWindows() > 0 && lab.simulation().boundary != Boundary::Periodic;
+  s["shear_band"] = shearBandJson(lab.lastShearBand(), bandMeasured, lab.simulation(), lab.d50(), bandOnset(records),
+                                  m.eps1AtPeak);
+  s["shear_band_method"] = fmt::format(
+      "from the strain increment over windows of output.band_strain_window = {:g} of the driving strain, one "
+      "closing at the first record past its length (timeseries band_measured = 1 there; the last at the end of "
+      "the test when half a window has passed): the load-bearing grains whose local eq over the window is >= "
+      "output.band_factor times the sample's; a band when they are >= 20 and <= half the load-bearing grains and "
+      "lie in a slab (smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the "
+      "centroids of full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, "
+      "thickness_d50 = full width at half height of the mean eq profile across it (bins of d50) above the "
+      "background (the median eq outside); void_ratio_inside/outside: the box's volume and the grains' solid (by "
+      "spherical caps, exact for spheres) within and beyond the slab of that thickness at the end; shear_band is "
+      "the last window's band (detected false: none found there; null: no window closed, or a periodic cell, "
+      "where a band may wrap across the faces); onset_eps1 = the end of the first window from which every window "
+      "to the end has a band, onset_over_peak = that over eps1_at_peak",
+      config.output.bandStrainWindow);
   // I = rate d50 sqrt(rho/p) with the p measured at each record.
   const double inertialMax = inertialMaxOf(records);
   s["inertial_number_max"] = inertialMax;
@@ -549,11 +551,24 @@ ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Labor
   return out;
 }
 
-Json shearBandJson(const std::optional<ShearBand>& b, const Simulation& sim, double d50) {
-  if (!b) return nullptr;
+Json shearBandJson(const std::optional<ShearBand>& b, bool measured, const Simulation& sim, double d50,
+                   std::optional<double> onset, double eps1AtPeak) {
+  if (!b) {
+    Json none = Json::object();
+    none["detected"] = measured ? Json(false) : Json(nullptr);
+    for (const char* key : {"inclination_deg", "thickness_d50", "onset_eps1", "onset_over_peak", "void_ratio_inside",
+                            "void_ratio_outside", "normal", "centre", "grains", "flatness", "peak_local_strain",
+                            "background_local_strain"})
+      none[key] = nullptr;
+    return none;
+  }
   const std::optional<BandVoidRatios> e = bandVoidRatios(*b, sim.particles.position, sim.particles.semiAxes,
                                                           sim.box.lowerCorner(), sim.box.upperCorner());
-  return {{"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
+  return {{"detected", true},
+          {"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
+          {"onset_eps1", optional(onset)},
+          {"onset_over_peak", onset && eps1AtPeak > 0.0 ? Json(finite(*onset / eps1AtPeak, "shear_band.onset_over_peak"))
+                                                       : Json(nullptr)},
           {"void_ratio_inside", e ? Json(finite(e->inside, "shear_band.void_ratio_inside")) : Json(nullptr)},
           {"void_ratio_outside", e ? Json(finite(e->outside, "shear_band.void_ratio_outside")) : Json(nullptr)},
           {"thickness_d50", finite(b->thickness / d50, "shear_band.thickness_d50")},
@@ -567,7 +582,11 @@ Json shearBandJson(const std::optional<ShearBand>& b, const Simulation& sim, dou
 
 std::optional<double> bandOnset(const std::vector<Record>& records) {
   std::optional<double> onset;
-  for (auto r = records.rbegin(); r != records.rend() && std::isfinite(r->bandInclinationDeg); ++r) onset = r->eps1;
+  for (auto r = records.rbegin(); r != records.rend(); ++r) {
+    if (r->bandMeasured == 0.0) continue;
+    if (!std::isfinite(r->bandInclinationDeg)) break;
+    onset = r->eps1;
+  }
   return onset;
 }
 

@@ -46,12 +46,16 @@ struct ShearReport {
 };
 ShearReport reportShear(const RunConfig& config, const ShearResult& shear, Laboratory& lab, Json& summary);
 
-// summary.json's shear_band: the band's plane, thickness in d50 and the void ratios inside and
-// outside it in the wall box of `sim`; null without a band.
-Json shearBandJson(const std::optional<ShearBand>& band, const Simulation& sim, double d50);
+// summary.json's shear_band: `detected`, the band's plane, thickness in d50, the void ratios inside
+// and outside it in the wall box of `sim`, and its onset (eps1, and over `eps1AtPeak`). `detected`
+// is null when the band was not looked for (`measured` false: no strain window closed, or a periodic
+// cell), false when no band was found; every other value is null without a band.
+Json shearBandJson(const std::optional<ShearBand>& band, bool measured, const Simulation& sim, double d50,
+                   std::optional<double> onset, double eps1AtPeak);
 
-// The shear band's onset: eps1 of the first record from which every record to the end has a band
-// (Record::bandInclinationDeg finite); null when the last record has none.
+// The shear band's onset: eps1 of the first window-closing record (Record::bandMeasured) from which
+// every window to the end has a band (Record::bandInclinationDeg finite); null when the last window
+// has none.
 std::optional<double> bandOnset(const std::vector<Record>& records);
 
 // The micromechanics columns of one record by name, null where not measurable, with its energy

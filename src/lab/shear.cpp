@@ -73,9 +73,9 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   r.rotationOutsideMeanDeg = k.rotationOutsideMeanDeg;
   r.rotationBandStdDeg = k.rotationBandStdDeg;
   r.rotationOutsideStdDeg = k.rotationOutsideStdDeg;
-  const std::optional<ShearBand> band = shearBand(k);
-  r.bandInclinationDeg = band ? band->inclinationDeg : std::nan("");
-  r.bandThicknessD50 = band ? band->thickness / d50_ : std::nan("");
+  // The band is measured where a window closes (closeBandWindow), not at every record.
+  r.bandInclinationDeg = std::nan("");
+  r.bandThicknessD50 = std::nan("");
   r.kinetic = kineticEnergy(sim_);
   r.elastic = elasticEnergy(sim_);
   r.workBoundary = sim_.energy.boundaryWork;
@@ -140,6 +140,11 @@ void Laboratory::beginShear() {
   st.rampSteps = std::max(1L, static_cast<long>(kPlatenRampIntegralTimes * config_.solver.servoIntegralSteps));
   st.started = true;
   records_.reset(sim_);
+  // The first band window starts here.
+  window_ = records_;
+  previousWindow_ = records_;
+  for (int a = 0; a < 3; ++a) st.windowLengths[a] = sim_.box.length(a);
+  st.previousWindowLengths = st.windowLengths;
   sim_.energy = EnergyLedger{};
   st.elastic0 = elasticEnergy(sim_);
   st.kinetic0 = kineticEnergy(sim_);
@@ -252,6 +257,11 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
     st.wallStressSum.fill(0.0);
     st.stressSamples = 0;
     r.loopPhase = st.loopPhase;
+    // A band window closes at the first record past its length, and at the end of the test when
+    // at least half a window has passed.
+    const double window = config_.output.bandStrainWindow;
+    const double windowDone = *strain - st.windowStrain;
+    if (windowDone >= window * (1.0 - 1e-9) || (*last && windowDone >= 0.5 * window)) closeBandWindow(r, *strain);
     protocol.recorded(r);
     st.result.records.push_back(r);
     while (st.nextRecord <= *strain) st.nextRecord += *strain < 0.01 ? 0.1 * every : every;

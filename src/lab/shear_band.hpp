@@ -23,6 +23,7 @@
 // single plane does not describe it (the report leaves it null there).
 #include <cstddef>
 #include <optional>
+#include <tuple>
 #include <vector>
 
 #include "core/types.hpp"
@@ -45,6 +46,12 @@ struct ShearBand {
   double flatness = 0.0;        // smallest / middle eigenvalue of the flagged grains' covariance
   double peakStrain = 0.0, backgroundStrain = 0.0;  // of the profile [-]
   std::size_t grains = 0;       // load-bearing grains flagged in the band
+  // Every field, in the order a checkpoint holds them (stateio::Listed).
+  template <class Self>
+  static auto fields(Self& s) {
+    return std::tie(s.normal, s.centre, s.inclinationDeg, s.thickness, s.flatness, s.peakStrain, s.backgroundStrain,
+                    s.grains);
+  }
 };
 
 // `inBand`, `active` (empty: every grain) per grain as in GrainKinematics.

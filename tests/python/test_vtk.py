@@ -65,7 +65,36 @@ def test_band_slice_plot(grainlab, data_dir, tmp_path):
     out = tmp_path / "run"
     grainlab("run", os.path.join(data_dir, "small-triaxial.toml"), "--out", str(out), "--quiet",
              "--set", "sample.n_particles=100", "--set", "test.final_axial_strain=0.01",
+             "--set", "output.band_strain_window=0.0025",
              "--set", "output.vtk_every_strain=0.01", "--set", "output.plots=true", check=0)
     summary = json.loads((out / "summary.json").read_text())
-    assert "shear_band" in summary and "shear_band_onset_eps1" in summary
+    band = summary["shear_band"]
+    # Four windows of 0.25 % closed: the band was looked for, so detected is a bool, and every value
+    # but detected is null exactly when no band was found.
+    assert isinstance(band["detected"], bool)
+    for key, value in band.items():
+        if key not in ("detected", "onset_eps1", "onset_over_peak", "void_ratio_inside", "void_ratio_outside"):
+            assert (value is None) == (not band["detected"]), key
     assert (out / "plots" / "band_slice.png").stat().st_size > 1000
+    with open(out / "timeseries.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    closed = [float(r["eps1"]) for r in rows if r["band_measured"] == "1"]
+    # One window closes at the first record past each 0.25 % of axial strain since the last one, and
+    # a last one at the end of the test (at least half a window).
+    assert 4 <= len(closed) <= 5, closed
+    assert closed[-1] == float(rows[-1]["eps1"])
+    starts = [0.0] + closed[:-1]
+    for start, end in zip(starts[:-1], closed[:-1]):
+        assert 0.0025 * (1 - 1e-6) <= end - start < 0.0025 + 0.0002, (start, end)
+    assert 0.00125 * (1 - 1e-6) <= closed[-1] - starts[-1] < 0.0025 + 0.0002
+    # Between the window ends the band was not looked for: its columns are empty.
+    for r in rows:
+        if r["band_measured"] == "0":
+            assert r["band_inclination_deg"] == "" and r["band_thickness_d50"] == ""
+    # The increment field of the last window is in the snapshots, beside the cumulative one.
+    last = sorted((out / "vtk").glob("particles_*.vtu"))[-1]
+    m = meshio.read(last)
+    for field in ("strain_increment", "in_band_increment", "local_shear_strain", "in_band"):
+        assert field in m.point_data, field
+    inc = m.point_data["strain_increment"].ravel()
+    assert np.all(np.isfinite(inc)) and inc.max() > 0

@@ -141,22 +141,29 @@ TEST(RunReport, MicroColumnsNullWhereNotMeasured) {
   EXPECT_DOUBLE_EQ(j["eps1"].get<double>(), 0.03);
 }
 
-// The band's onset is where it appears for good: a band seen at one record and lost at the next
-// does not count; none at the last record is no onset.
+// The band's onset is where it appears for good: a band seen at one window and lost at the next
+// does not count; none in the last window is no onset. Records between windows (band not looked
+// for, bandMeasured 0) neither end nor start a band.
 TEST(RunReport, BandOnsetIsWhereTheBandStaysToTheEnd) {
   const double none = std::nan("");
+  const double between = -1.0;  // a record between two window ends
   auto records = [&](std::vector<double> inclination) {
     std::vector<lab::Record> r(inclination.size());
     for (std::size_t i = 0; i < r.size(); ++i) {
       r[i].eps1 = 0.01 * static_cast<double>(i);
-      r[i].bandInclinationDeg = inclination[i];
+      r[i].bandMeasured = inclination[i] == between ? 0.0 : 1.0;
+      r[i].bandInclinationDeg = inclination[i] == between ? none : inclination[i];
     }
     return r;
   };
   const auto onset = lab::bandOnset(records({none, 55.0, none, 58.0, 60.0}));
   ASSERT_TRUE(onset);
   EXPECT_DOUBLE_EQ(*onset, 0.03);
-  EXPECT_FALSE(lab::bandOnset(records({none, 55.0, 56.0, none})));
+  const auto sparse = lab::bandOnset(records({none, between, 55.0, between, between, 58.0, between}));
+  ASSERT_TRUE(sparse);
+  EXPECT_DOUBLE_EQ(*sparse, 0.02);
+  EXPECT_FALSE(lab::bandOnset(records({none, 55.0, between, none, between})));
+  EXPECT_FALSE(lab::bandOnset(records({between, between})));
   EXPECT_FALSE(lab::bandOnset({}));
 }
 
@@ -174,11 +181,20 @@ TEST(RunReport, ShearBandKeys) {
   b.inclinationDeg = 60.0;
   b.thickness = 6e-3;
   b.grains = 900;
-  const lab::Json j = lab::shearBandJson(b, sim, 1e-3);
+  const lab::Json j = lab::shearBandJson(b, true, sim, 1e-3, 0.04, 0.05);
+  EXPECT_TRUE(j["detected"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["onset_eps1"].get<double>(), 0.04);
+  EXPECT_DOUBLE_EQ(j["onset_over_peak"].get<double>(), 0.8);
   EXPECT_DOUBLE_EQ(j["inclination_deg"].get<double>(), 60.0);
   EXPECT_DOUBLE_EQ(j["thickness_d50"].get<double>(), 6.0);
   EXPECT_EQ(j["grains"].get<int>(), 900);
   EXPECT_NEAR(j["void_ratio_inside"].get<double>(), 6.0 / M_PI - 1.0, 0.03);
   EXPECT_NEAR(j["void_ratio_outside"].get<double>(), 6.0 / M_PI - 1.0, 0.02);
-  EXPECT_TRUE(lab::shearBandJson(std::nullopt, sim, 1e-3).is_null());
+  // Looked for and not found: detected false; not looked for: null. Every other value null.
+  const lab::Json none = lab::shearBandJson(std::nullopt, true, sim, 1e-3, std::nullopt, 0.05);
+  EXPECT_FALSE(none["detected"].get<bool>());
+  EXPECT_EQ(none.size(), j.size());
+  for (const auto& [key, value] : none.items())
+    if (key != "detected") EXPECT_TRUE(value.is_null()) << key;
+  EXPECT_TRUE(lab::shearBandJson(std::nullopt, false, sim, 1e-3, std::nullopt, 0.05)["detected"].is_null());
 }

@@ -49,6 +49,11 @@ struct ShearStateMembers {
   long loopRestStart;
   bool forceRecord;
   double slowdown;
+  double windowStrain, previousWindowStrain;
+  Vec3 windowLengths, previousWindowLengths;
+  long bandWindows;
+  bool bandFound;
+  lab::ShearBand band;
 };
 
 }  // namespace
@@ -89,7 +94,8 @@ static_assert(sizeof(Simulation) ==
 static_assert(sizeof(lab::Laboratory) ==
                   layoutSize<lab::RunConfig, lab::ProgressFn, lab::SnapshotFn, double, lab::CheckpointFn, double,
                              std::unique_ptr<lab::ShearProtocol>, std::unique_ptr<lab::BoundaryControl>,
-                             ShearStateMembers, Simulation, lab::GrainRecords, lab::MicroAnalyzer,
+                             ShearStateMembers, Simulation, lab::GrainRecords, lab::GrainRecords,
+                             lab::GrainRecords, lab::MicroAnalyzer,
                              lab::MicroColumnSet, double, std::vector<lab::GrowthStage>,
                              std::optional<lab::DepositionReport>, std::vector<std::vector<double>>,
                              std::optional<lab::UnderCompactionReport>>(),
@@ -169,6 +175,36 @@ TEST(StateIo, ReloadedLaboratoryContinuesBitForBit) {
     EXPECT_EQ(pa.position[i], pb.position[i]);
     EXPECT_EQ(pa.orientation[i].coeffs(), pb.orientation[i].coeffs());
   }
+}
+
+// The shear band's windows (output.band_strain_window) are part of the state: a laboratory loaded
+// from a checkpoint taken after several windows closed writes the same bytes back, closes its next
+// windows at the same records and measures the same strain increment.
+TEST(StateIo, BandWindowsSurviveACheckpoint) {
+  lab::RunConfig c = smallConfig();
+  c.output.bandStrainWindow = 2e-4;
+  lab::Laboratory whole(c);
+  std::string state;
+  whole.onCheckpoint([&state](const lab::Laboratory& l) { if (state.empty() && l.bandWindows() >= 3) state = saved(l); },
+                     1e-4);
+  whole.prepare();
+  const lab::ShearResult a = whole.shear();
+  ASSERT_FALSE(state.empty());
+  lab::Laboratory resumed(c);
+  stateio::MemoryInput in(state);
+  resumed.loadState(in);
+  EXPECT_GE(resumed.bandWindows(), 3);
+  EXPECT_EQ(saved(resumed), state);
+  const lab::ShearResult b = resumed.continueShear();
+  ASSERT_EQ(a.records.size(), b.records.size());
+  long windows = 0;
+  for (std::size_t i = 0; i < a.records.size(); ++i) {
+    EXPECT_EQ(a.records[i].bandMeasured, b.records[i].bandMeasured) << i;
+    windows += a.records[i].bandMeasured != 0.0;
+  }
+  EXPECT_GE(windows, 10);
+  EXPECT_EQ(whole.bandWindows(), resumed.bandWindows());
+  EXPECT_EQ(whole.incrementKinematics().localShearStrain, resumed.incrementKinematics().localShearStrain);
 }
 
 TEST(StateIo, EveryTruncationIsAnErrorNeverACrash) {
