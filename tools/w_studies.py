@@ -359,7 +359,7 @@ def replicates_report(opt):
                 d = float(row[k + "_mean"]) - float(base[k + "_mean"])
                 bound = 2 * max(float(row[k + "_std"]), float(base[k + "_std"]))
                 if abs(d) > bound:
-                    trends.append(f"{name.split(' ')[0]} {d:+.{digits}f}")
+                    trends.append(f"{name.rsplit(' [', 1)[0]} {d:+.{digits}f}")
             trend = (", ".join(trends) if trends else "none beyond the scatter") if compared else "not measurable"
         else:
             trend = "–"
