@@ -288,10 +288,8 @@ void Laboratory::closeBandWindow(Record& r, double strain) {
   st.band = band.value_or(ShearBand{});
   ++st.bandWindows;
   previousWindow_ = std::move(window_);
-  st.previousWindowStrain = st.windowStrain;
   st.previousWindowLengths = st.windowLengths;
-  window_ = records_;
-  window_.reset(sim_);
+  window_.reset(sim_);  // the moved-from record; only positions, orientations and the cell are read
   st.windowStrain = strain;
   for (int a = 0; a < 3; ++a) st.windowLengths[a] = sim_.box.length(a);
 }
@@ -364,8 +362,7 @@ void Laboratory::loadState(std::istream& in) {
     if (st.started && (w->referencePosition.size() != sim_.particles.size() ||
                        w->referenceOrientation.size() != sim_.particles.size()))
       throw std::runtime_error("inconsistent state: the shear band's window records do not match the particles");
-  if (st.started && (st.bandWindows < 0 || !std::isfinite(st.windowStrain) || !std::isfinite(st.previousWindowStrain) ||
-                     st.previousWindowStrain > st.windowStrain ||
+  if (st.started && (st.bandWindows < 0 || !std::isfinite(st.windowStrain) ||
                      !(st.windowLengths.minCoeff() > 0.0 || sim_.boundary == Boundary::Periodic) ||
                      !(st.previousWindowLengths.minCoeff() > 0.0 || sim_.boundary == Boundary::Periodic)))
     throw std::runtime_error("inconsistent state: the shear band's strain windows");

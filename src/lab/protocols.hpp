@@ -299,10 +299,10 @@ class Laboratory {
     long loopRestStart = -1;   // the step a rest before an unload began (test.loop_rest)
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
-    // The shear band's strain windows (output.band_strain_window): the driving strain and the box
-    // lengths at the start of the current window and of the previous one (their grains in
+    // The shear band's strain windows (output.band_strain_window): the driving strain at the start
+    // of the current window, the box lengths there and at the previous one's (their grains in
     // window_, previousWindow_), the windows closed, and the band of the last one.
-    double windowStrain = 0.0, previousWindowStrain = 0.0;
+    double windowStrain = 0.0;
     Vec3 windowLengths = Vec3::Zero(), previousWindowLengths = Vec3::Zero();
     long bandWindows = 0;
     bool bandFound = false;
@@ -314,7 +314,7 @@ class Laboratory {
       return std::tie(s.started, s.h0, s.v0, s.l0, s.rampSteps, s.startStep, s.nextRecord, s.nextSnapshot,
                       s.nextCheckpoint, s.stressSum, s.shearStressSum, s.wallStressSum, s.stressSamples, s.elastic0,
                       s.kinetic0, s.result, s.loopNext, s.loopPhase, s.loopQ, s.loopEndStep, s.loopRestStart,
-                      s.forceRecord, s.slowdown, s.windowStrain, s.previousWindowStrain, s.windowLengths,
+                      s.forceRecord, s.slowdown, s.windowStrain, s.windowLengths,
                       s.previousWindowLengths, s.bandWindows, s.bandFound, s.band);
     }
   };

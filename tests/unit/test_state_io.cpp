@@ -49,7 +49,7 @@ struct ShearStateMembers {
   long loopRestStart;
   bool forceRecord;
   double slowdown;
-  double windowStrain, previousWindowStrain;
+  double windowStrain;
   Vec3 windowLengths, previousWindowLengths;
   long bandWindows;
   bool bandFound;
