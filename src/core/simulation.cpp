@@ -52,7 +52,22 @@ const std::vector<Simulation::EngineStage>& Simulation::engineStages(Boundary ki
        kPositions | kVelocities | kRotations | kForces | kEnergy},
       {"clock", &Simulation::advanceClock, true, kClock, kClock},
   };
-  return kind == Boundary::Periodic ? periodic : walls;
+  // A membrane sample: the platens are walls; the membrane stage loads the surface grains (and
+  // servoes its pressure when it keeps the volume) after the platens' forces are known.
+  static const std::vector<EngineStage> membrane{
+      {"broad phase", &Simulation::updateBroadPhase, true, kPositions | kBoundary | kContacts,
+       kPositions | kContacts},
+      {"contacts", &Simulation::computeContactsFor<false>, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary, kContacts | kEnergy},
+      {"boundary forces", &Simulation::measureWalls, false, kContacts | kBoundary, kBoundary},
+      {"membrane", &Simulation::membraneStage, true, kPositions | kBoundary, kBoundary},
+      {"boundary control", &Simulation::controlWallStage, true, kBoundary, kBoundary | kEnergy},
+      {"integrate", &Simulation::integrateFor<false>, false,
+       kPositions | kVelocities | kRotations | kContacts | kBoundary,
+       kPositions | kVelocities | kRotations | kForces | kEnergy},
+      {"clock", &Simulation::advanceClock, true, kClock, kClock},
+  };
+  return kind == Boundary::Periodic ? periodic : kind == Boundary::Membrane ? membrane : walls;
 }
 
 std::size_t Simulation::engineStageIndex(Boundary kind, const std::string& name) {
@@ -352,14 +367,42 @@ void Simulation::controlCellStage() {
   serial([&] { controlCell(); });
 }
 
+void Simulation::membraneStage() {
+  serial([&] {
+    for (std::uint32_t g : membrane.grain) membraneLoad_[g] = Vec3::Zero();
+    membrane.measure(particles, box.lower(2).position, box.upper(2).position);
+    if (membrane.rigid) {
+      // Forces from where the cylinder is, then it moves (as a wall's force, then its servo).
+      membrane.applyCylinder(particles, [&](double r) { return model.wallParams(r, 0.0).kn; });
+      const double before = membrane.radius;
+      membrane.servoCylinder(dt, servo.gain, servo.integralSteps, servo.maxSpeed);
+      energy.boundaryWork += membrane.radialForce * (before - membrane.radius);
+    } else {
+      // The confined modulus the volume servo scales its correction by: the platens' contact
+      // stiffness over the area, times the height (the sample's axial stiffness as a modulus).
+      const double area = membrane.platenArea();
+      const double platens = 0.5 * (box.lower(2).contactStiffness + box.upper(2).contactStiffness);
+      if (area > 0.0) membrane.servo(platens * membrane.height / area);
+      membrane.applyPressure(particles);
+    }
+    refreshMembrane();
+  });
+}
+
+void Simulation::refreshMembrane() {
+  if (membraneLoad_.size() != particles.size()) membraneLoad_.assign(particles.size(), Vec3::Zero());
+  for (std::size_t k = 0; k < membrane.grain.size(); ++k) membraneLoad_[membrane.grain[k]] = membrane.force[k];
+}
+
 void Simulation::controlWalls() {
   for (Wall& wall : box.walls) {
     if (wall.control != WallControl::Stress) continue;
-    const double sigma = wall.normalForce / box.area(wall.axis);
+    const double area = wallArea(wall.axis);
+    const double sigma = wall.normalForce / area;
     const double error = wall.targetStress - sigma;  // > 0: push further in
     double inwardSpeed = servo.maxSpeed;
     if (wall.contactStiffness > 0.0) {
-      const double u = error * box.area(wall.axis) / wall.contactStiffness;
+      const double u = error * area / wall.contactStiffness;
       if (servo.integralSteps > 0.0)
         wall.servoIntegral = std::clamp(wall.servoIntegral + servo.gain * u / (servo.integralSteps * dt),
                                         -servo.maxSpeed, servo.maxSpeed);
@@ -496,6 +539,9 @@ void Simulation::integrateFor() {
   // chunk at a time after the chunk's gather: the same bits as the per-particle kernel.
   const bool vectorised = kernels::simdEnabled() && viscousDamping <= 0.0;
   const Shape* shape = particles.shape.data();
+  const bool membraneOn = boundary == Boundary::Membrane;
+  if (membraneOn && membraneLoad_.size() != particles.size()) membraneLoad_.assign(particles.size(), Vec3::Zero());
+  const Vec3* membraneLoad = membraneLoad_.data();
   kernels::StepChecks checks;
   checks.positionsAtBuild = xBuild.empty() ? nullptr : xBuild.data();
   checks.deformation = deformation;
@@ -511,10 +557,13 @@ void Simulation::integrateFor() {
     kernels::ChecksResult r;
     if (vectorised && std::all_of(shape + first, shape + last, [](Shape s) { return s == Shape::Sphere; })) {
       for (std::size_t i = first; i < last; ++i) gatherParticle(i);
+      if (membraneOn)
+        for (std::size_t i = first; i < last; ++i) particles.force[i] += membraneLoad[i];
       r = kernels::integrateSpheres(view, first, last, stepParams, Periodic, chunkWork, checks);
     } else {
       for (std::size_t i = first; i < last; ++i) {
         gatherParticle(i);
+        if (membraneOn) particles.force[i] += membraneLoad[i];
         chunkWork[i - first] = kernels::integrateParticle<Periodic>(view, i, stepParams);
         kernels::checkParticle<Periodic>(view, i, checks, r);
       }
@@ -540,6 +589,11 @@ void Simulation::finishIntegration(const Mat3& deformation) {
   auto& w = particles.angularVelocity;
   energy.damping -= sums.total(kDampingWork);
   if (gravity.squaredNorm() > 0.0) energy.gravityWork += sums.total(kGravityWork);
+  // The flexible membrane's work on its grains over the step: F . (x_new - x_old) = F . v dt
+  // (leapfrog); the rigid cylinder's is counted by its servo, as a wall's.
+  if (boundary == Boundary::Membrane && !membrane.rigid)
+    for (std::size_t k = 0; k < membrane.grain.size(); ++k)
+      energy.boundaryWork += membrane.force[k].dot(v[membrane.grain[k]]) * dt;
   const double maxDisp2 = std::max(0.0, sums.maxOf(kDisp2));
   const double bad = sums.minOf(kBadParticle);
   if (std::isfinite(bad)) {
@@ -626,6 +680,7 @@ void Simulation::saveState(std::ostream& out) const {
               &Wall::tanFriction, &Wall::servoIntegral, &Wall::normalForce, &Wall::contactStiffness, &Wall::contacts);
   put(out, box.referenceVolume);
   saveCell(out);
+  put(out, membrane);
   broadPhase.saveState(out);
   contacts.forEach([&](const auto& list) { list.saveState(out); });
   using M = contact::SphereContactModel;
@@ -648,6 +703,7 @@ void Simulation::loadState(std::istream& in) {
   get(in, boundary);
   get(in, box);
   loadCell(in);
+  get(in, membrane);
   broadPhase.loadState(in);
   contacts.forEach([&](auto& list) { list.loadState(in); });
   get(in, model);
@@ -664,6 +720,8 @@ void Simulation::loadState(std::istream& in) {
   validateState();
   particles.deriveAfterLoad();
   contacts.forEach([&](auto& list) { list.deriveAfterLoad(particles.size()); });
+  membraneLoad_.clear();
+  if (boundary == Boundary::Membrane) refreshMembrane();
 }
 
 }  // namespace grainlab

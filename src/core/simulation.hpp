@@ -19,6 +19,7 @@
 #include "contact/models.hpp"
 #include "core/broad_phase.hpp"
 #include "core/contact_list.hpp"
+#include "core/membrane.hpp"
 #include "core/parallel.hpp"
 #include "core/particles.hpp"
 #include "core/periodic_cell.hpp"
@@ -50,7 +51,9 @@ struct StageFlag {
   }
 };
 
-enum class Boundary : std::uint8_t { Walls = 0, Periodic = 1 };
+// Membrane: a cylindrical sample between the z walls of the box (the platens) inside a flexible
+// membrane (core/membrane.hpp); the box's x and y walls stand well clear of it.
+enum class Boundary : std::uint8_t { Walls = 0, Periodic = 1, Membrane = 2 };
 
 class Simulation {
  public:
@@ -58,6 +61,7 @@ class Simulation {
   Boundary boundary = Boundary::Walls;
   WallBox box;         // Boundary::Walls
   PeriodicCell cell;   // Boundary::Periodic
+  Membrane membrane;   // Boundary::Membrane (with the z walls of `box`)
   ContactStore contacts;
   BroadPhase broadPhase;
   contact::SphereContactModel model;
@@ -123,7 +127,19 @@ class Simulation {
   static std::size_t engineStageIndex(Boundary kind, const std::string& name);
 
   // Volume enclosed by the boundary [m^3].
-  double volume() const { return boundary == Boundary::Periodic ? cell.volume() : box.volume(); }
+  double volume() const {
+    return boundary == Boundary::Periodic ? cell.volume() : boundary == Boundary::Membrane ? membrane.volume : box.volume();
+  }
+  // The area a wall's force is spread over [m^2]: the box's face, or a membrane sample's mean
+  // cross-section for the platens.
+  double wallArea(int axis) const {
+    return boundary == Boundary::Membrane && axis == 2 ? membrane.platenArea() : box.area(axis);
+  }
+  // Wall k's stress [Pa], compression positive, over wallArea.
+  double wallStress(int k) const { return box.walls[k].normalForce / wallArea(box.walls[k].axis); }
+  // The membrane's grains and forces of the current step, from its lists (after a load or a change
+  // made outside step()).
+  void refreshMembrane();
   // Number of touching particle–particle contacts at the latest step.
   std::size_t touchingPairs() const;
 
@@ -139,6 +155,7 @@ class Simulation {
   void measureWalls();
   void controlWallStage();
   void controlCellStage();
+  void membraneStage();
   void advanceClock();
   void gatherParticle(std::size_t i);
   template <bool Periodic>
@@ -162,6 +179,9 @@ class Simulation {
   // rethrown by step() after the parallel region, and the stages after it are skipped.
   template <class F>
   void serial(F&& body);
+  // Per particle, the membrane's force of the step (zero off the surface): filled from
+  // membrane.grain/force, added after the gather.
+  std::vector<Vec3> membraneLoad_;
   bool rebuildDue_ = true;
   bool rebuilding_ = false;  // the broad phase is rebuilding in this step (set by its serial part)
   std::vector<geometry::Sym3> shapeMatrices_;  // scratch of the contact stage (ellipsoids)

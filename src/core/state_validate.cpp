@@ -57,7 +57,7 @@ void Simulation::validateState() const {
       bad(fmt::format("particle {}: mass or inertia not positive and finite", i));
     if (std::abs(P.orientation[i].norm() - 1.0) > 1e-6) bad(fmt::format("particle {}: orientation not a unit quaternion", i));
   }
-  if (boundary != Boundary::Walls && boundary != Boundary::Periodic) bad("unknown boundary");
+  if (boundary != Boundary::Walls && boundary != Boundary::Periodic && boundary != Boundary::Membrane) bad("unknown boundary");
   if (boundary == Boundary::Periodic) {
     if (!cell.h.allFinite() || !(cell.h.determinant() > 0.0)) bad("periodic cell matrix singular or non-finite");
   } else {
@@ -113,7 +113,29 @@ void Simulation::validateState() const {
   if (stepCount < 0 || !finiteIn(time, 0.0, 1e300)) bad("step count or time negative or not finite");
   for (double r : P.rollingFriction)
     if (!finiteIn(r, 0.0, 1e300)) bad("rolling friction not finite and >= 0");
-  if (boundary == Boundary::Walls) {
+  if (boundary == Boundary::Membrane) {
+    const Membrane& m = membrane;
+    if (m.control != MembraneControl::Pressure && m.control != MembraneControl::ConstantVolume) bad("unknown membrane control");
+    if (m.around < 1 || m.along < 1 || m.around > 100000 || m.along > 100000) bad("membrane bins out of range");
+    if (m.binRho.size() != static_cast<std::size_t>(m.around) * static_cast<std::size_t>(m.along) ||
+        m.binGrain.size() != m.binRho.size() || m.grain.size() != m.force.size())
+      bad("membrane bin lists of the wrong size");
+    for (std::int64_t g : m.binGrain)
+      if (g < -1 || g >= static_cast<std::int64_t>(P.size())) bad("membrane bin names a particle out of range");
+    for (std::uint32_t g : m.grain)
+      if (g >= P.size()) bad("membrane grain index out of range");
+    for (const Vec3& f : m.force)
+      if (!f.allFinite()) bad("membrane force not finite");
+    for (double r : m.binRho)
+      if (!finiteIn(r, 0.0, 1e300)) bad("membrane bin radius not finite and >= 0");
+    if (!std::isfinite(m.axisX) || !std::isfinite(m.axisY) || !finiteIn(m.pressure, 0.0, 1e300) ||
+        !finiteIn(m.stiffness, 0.0, 1e300) || !finiteIn(m.referenceRadius, 0.0, 1e300) ||
+        !finiteIn(m.referenceVolume, 0.0, 1e300) || !finiteIn(m.volumeGain, 0.0, 1e3) || !finiteIn(m.volumeIntegral, 0.0, 1.0) || !finiteIn(m.basePressure, 0.0, 1e300) || !finiteIn(m.shell, 0.0, 1e300) || !std::isfinite(m.bottom) || !finiteIn(m.volume, 0.0, 1e300) ||
+        !finiteIn(m.height, 0.0, 1e300) || !finiteIn(m.area, 0.0, 1e300) || !std::isfinite(m.radialForce) ||
+        !std::isfinite(m.hoopPressure))
+      bad("membrane settings or measurements not finite or out of range");
+  }
+  if (boundary != Boundary::Periodic) {
     for (const Wall& w : box.walls)
       if ((w.control != WallControl::Fixed && w.control != WallControl::Velocity && w.control != WallControl::Stress &&
            w.control != WallControl::ConstantVolume) ||

@@ -46,7 +46,7 @@ std::string hex(std::uint64_t v) { return fmt::format("{:016x}", v); }
 std::uint64_t stateLayoutTag() {
   using stateio::fieldCount;
   // Everything whose size or field list shapes the bytes of Laboratory::saveState.
-  const std::array<std::uint64_t, 24> shape{
+  const std::array<std::uint64_t, 25> shape{
       kCheckpointFormat,
       fieldCount<Particles>(),
       sizeof(Wall),
@@ -71,6 +71,7 @@ std::uint64_t stateLayoutTag() {
       sizeof(lab::ProtocolState),
       fieldCount<lab::ProtocolState>(),
       lab::Laboratory::shearStateFieldCount(),
+      fieldCount<Membrane>(),
   };
   return XXH64(shape.data(), sizeof(shape), 0);
 }

@@ -204,7 +204,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
         "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
-        "n_cycles", "ru_limit", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude"}},
+        "n_cycles", "ru_limit", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude", "aspect_ratio", "membrane_young",
+        "membrane_thickness", "membrane_bin_d50", "platen_friction_deg"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
         "stress_tolerance", "servo_gain", "servo_integral_steps", "servo_max_speed", "skin_fraction", "max_steps"}},
@@ -553,6 +554,11 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "give either contact.rolling_friction or contact.sphericity, not both";
   if (key == "contact.wall_friction_deg" && c.test.boundary == "periodic")
     return "a periodic cell has no walls; " + here("test.boundary", c.test.boundary);
+  if ((key == "test.aspect_ratio" || key == "test.membrane_young" || key == "test.membrane_thickness" ||
+       key == "test.membrane_bin_d50") && c.test.boundary != "membrane")
+    return "only used with test.boundary = \"membrane\"; " + here("test.boundary", c.test.boundary);
+  if (key == "test.platen_friction_deg" && c.test.boundary == "periodic")
+    return "a periodic cell has no platens; " + here("test.boundary", c.test.boundary);
   if (key == "contact.young" && c.contact.kn)
     return "not used with contact.kn (every contact has the constant normal stiffness kn)";
   if (key == "test.b" && type != "true-triaxial")
@@ -983,7 +989,17 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     const std::string type = t.string("type", std::string(lab::name(c.test.type)), names);
     c.test.type = *lab::parseTestType(type);  // one of names
   }
-  c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic"});
+  c.test.boundary = t.string("boundary", c.test.boundary, {"walls", "periodic", "membrane"});
+  c.test.aspectRatio = t.number("aspect_ratio", c.test.aspectRatio, 0.5, 4.0, false, false,
+                                "must be in [0.5, 4] (height / diameter of the cylindrical sample)");
+  c.test.membraneYoung = t.number("membrane_young", c.test.membraneYoung, 0.0, 1e10, false, false,
+                                  "must be in [0, 1e10] [Pa] (Young modulus of the membrane; 0: the cell pressure alone)");
+  c.test.membraneThickness = t.number("membrane_thickness", c.test.membraneThickness, 0.0, 1.0, true, false,
+                                      "must be in (0, 1] [m] (thickness of the membrane)");
+  c.test.membraneBinD50 = t.number("membrane_bin_d50", c.test.membraneBinD50, 0.5, 4.0, false, false,
+                                   "must be in [0.5, 4] (side of the membrane's bins in d50)");
+  if (t.raw("platen_friction_deg"))
+    c.test.platenFrictionDeg = t.number("platen_friction_deg", 0.0, 0.0, 90.0, false, true, "must be in [0, 90) [deg]");
   if (c.test.boundary == "periodic" && c.sample.gravity)
     fail("sample.gravity", fmt::format("[{}, {}, {}]", (*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]),
          c.sample.method == "deposition" || c.sample.method == "under-compaction"
@@ -1136,6 +1152,32 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
            "sample.method = \"lattice\" places equal spheres (the grading's d50): allowed a grading of one size, d_max <= "
            "1.01 d_min, e.g. { type = \"uniform\", d_min = 2e-3, d_max = 2e-3 }");
   }
+  if (c.test.boundary == "membrane") {
+    // A cylinder in a membrane: an axisymmetric loading of spheres prepared by compaction.
+    const lab::TestType tt = c.test.type;
+    if (tt == lab::TestType::TrueTriaxial || tt == lab::TestType::Oedometer)
+      fail("test.type", fmt::format("\"{}\"", lab::name(tt)),
+           "not with test.boundary = \"membrane\" (a membrane holds one lateral stress and cannot stop the lateral "
+           "strain); allowed there: \"isotropic\", \"triaxial\", \"constant-p\", \"cyclic-triaxial\", \"stress-path\"");
+    for (const lab::PathPoint& pt : c.test.path)
+      if (pt.control[0] != lab::PathControl::Stress || pt.control[1] != lab::PathControl::Stress || pt.value[0] != pt.value[1])
+        fail("test.path", c.test.pathSource.empty() ? std::string("(inline)") : c.test.pathSource,
+             "with test.boundary = \"membrane\" every point must give equal stresses for x and y (the membrane's one "
+             "lateral stress); allowed: sigma_x = sigma_y targets, z a stress or a strain");
+    if (!c.sample.packing.empty())
+      fail("sample.packing", io::quotedPath(c.sample.packing),
+           "not with test.boundary = \"membrane\" (a packing file holds a box or a cell); allowed: a sample prepared "
+           "by sample.method = \"compaction\" or \"loose-moment-free\"");
+    if (c.sample.method != "compaction" && c.sample.method != "loose-moment-free")
+      fail("sample.method", fmt::format("\"{}\"", c.sample.method),
+           "not with test.boundary = \"membrane\"; allowed: \"compaction\", \"loose-moment-free\"");
+    if (c.sample.shape.type == "ellipsoid")
+      fail("sample.shape.type", "\"ellipsoid\"", "not with test.boundary = \"membrane\" (its grains are spheres); "
+           "allowed: \"sphere\"");
+    if (c.sample.gravity)
+      fail("sample.gravity", fmt::format("[{}, {}, {}]", (*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]),
+           "not with test.boundary = \"membrane\" (no hydrostatic cell pressure); allowed: no gravity");
+  }
   refuseInapplicable(root, c);
   return c;
 }
@@ -1212,6 +1254,11 @@ toml::table resolvedTable(const lab::RunConfig& c) {
                    {"confining_pressure", c.test.confiningPressure},
                    {"probe_strain", c.test.probeStrain}};
   put(test, "test", "final_axial_strain", c.test.finalAxialStrain);
+  put(test, "test", "aspect_ratio", c.test.aspectRatio);
+  put(test, "test", "membrane_young", c.test.membraneYoung);
+  put(test, "test", "membrane_thickness", c.test.membraneThickness);
+  put(test, "test", "membrane_bin_d50", c.test.membraneBinD50);
+  if (c.test.platenFrictionDeg) put(test, "test", "platen_friction_deg", *c.test.platenFrictionDeg);
   put(test, "test", "b", c.test.b);
   put(test, "test", "final_shear_strain", c.test.finalShearStrain);
   if (c.test.axialStrainRate) put(test, "test", "axial_strain_rate", *c.test.axialStrainRate);

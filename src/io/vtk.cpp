@@ -40,6 +40,11 @@ std::string particlesVtu(const Simulation& sim, const PointFields& extra) {
   v.pointVector("semi_axes", semiAxes);
   v.pointVector("axis_a", axisA);
   v.pointTensor("shape_tensor", shapeTensor);
+  if (sim.boundary == Boundary::Membrane) {  // what the membrane presses on each grain with
+    std::vector<Vec3> load(n, Vec3::Zero());
+    for (std::size_t k = 0; k < sim.membrane.grain.size(); ++k) load[sim.membrane.grain[k]] += sim.membrane.force[k];
+    v.pointVector("membrane_force", load);
+  }
   for (const auto& [name, values] : extra.scalars) v.pointScalar(name, values);
   for (const auto& [name, values] : extra.vectors) v.pointVector(name, values);
   return v.text();
@@ -74,8 +79,48 @@ std::string contactsVtu(const Simulation& sim) {
   return v.text();
 }
 
+std::string membraneVtu(const Simulation& sim) {
+  // The membrane as it is measured: one quad per bin at its radius rho_b (the row's mean radius
+  // where a bin is empty), with the radial stress on it; and the two platens as polygons of the
+  // mean radius, with their stresses.
+  const Membrane& m = sim.membrane;
+  const double dTheta = 2.0 * kPi / m.around, dz = m.height / m.along;
+  const double meanRadius = m.equivalentRadius();
+  VtuPiece v;
+  std::vector<Vec3> points;
+  std::vector<double> stress, radius;
+  auto corner = [&](double rho, int a, double z) {
+    const double theta = -kPi + a * dTheta;
+    points.emplace_back(m.axisX + rho * std::cos(theta), m.axisY + rho * std::sin(theta), z);
+    return static_cast<std::int64_t>(points.size() - 1);
+  };
+  const double p = m.radialStress();
+  for (int k = 0; k < m.along; ++k)
+    for (int a = 0; a < m.around; ++a) {
+      const std::size_t b = static_cast<std::size_t>(k) * static_cast<std::size_t>(m.around) + static_cast<std::size_t>(a);
+      const double rho = b < m.binGrain.size() && m.binGrain[b] >= 0 ? m.binRho[b] : meanRadius;
+      const double z0 = m.bottom + k * dz;
+      v.cell({corner(rho, a, z0), corner(rho, a + 1, z0), corner(rho, a + 1, z0 + dz), corner(rho, a, z0 + dz)},
+             VtuPiece::kQuad);
+      stress.push_back(b < m.binGrain.size() && m.binGrain[b] >= 0 ? p : 0.0);
+      radius.push_back(rho);
+    }
+  for (int side = 0; side < 2; ++side) {
+    std::vector<std::int64_t> ring;
+    for (int a = 0; a < m.around; ++a) ring.push_back(corner(meanRadius, a, sim.box.walls[WallBox::index(2, side)].position));
+    v.cell(ring, VtuPiece::kPolygon);
+    stress.push_back(sim.wallStress(WallBox::index(2, side)));
+    radius.push_back(meanRadius);
+  }
+  v.points(points);
+  v.cellScalar("normal_stress", stress);
+  v.cellScalar("radius", radius);
+  return v.text();
+}
+
 std::string wallsVtu(const Simulation& sim) {
   if (sim.boundary == Boundary::Periodic) return cellVtu(sim);
+  if (sim.boundary == Boundary::Membrane) return membraneVtu(sim);
   const WallBox& box = sim.box;
   const Vec3 lo = box.lowerCorner(), hi = box.upperCorner();
   std::vector<Vec3> corners;
@@ -123,7 +168,9 @@ void VtkSeries::write(const Simulation& sim, double label, const PointFields& ex
   const std::size_t index = labels_.size();
   writeFileAtomic(dir_ / fmt::format("particles_{:04d}.vtu", index), particlesVtu(sim, extra));
   writeFileAtomic(dir_ / fmt::format("contacts_{:04d}.vtu", index), contactsVtu(sim));
-  const char* boundary = sim.boundary == Boundary::Periodic ? "cell" : "walls";
+  const char* boundary = sim.boundary == Boundary::Periodic   ? "cell"
+                         : sim.boundary == Boundary::Membrane ? "membrane"
+                                                              : "walls";
   writeFileAtomic(dir_ / fmt::format("{}_{:04d}.vtu", boundary, index), wallsVtu(sim));
   labels_.push_back(label);
   for (const char* kind : {"particles", "contacts", boundary})

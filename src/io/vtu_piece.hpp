@@ -15,7 +15,7 @@ namespace grainlab::io {
 // VTK and meshio).
 class VtuPiece {
  public:
-  static constexpr std::uint8_t kVertex = 1, kLine = 3, kQuad = 9, kHexahedron = 12;  // VTK cell types
+  static constexpr std::uint8_t kVertex = 1, kLine = 3, kPolygon = 7, kQuad = 9, kHexahedron = 12;  // VTK cell types
 
   void points(const std::vector<Vec3>& p) { points_ = p; }
   void cell(const std::vector<std::int64_t>& nodes, std::uint8_t vtkType) {

@@ -139,10 +139,98 @@ class CellBoundary final : public BoundaryControl {
   Vec3 lengths() const override { return sim_.cell.h.diagonal(); }
 };
 
+// A cylinder between the platens (the box's z walls) in a membrane (core/membrane.hpp): axis 2 is
+// the platens', axes 0 and 1 are both the membrane's one lateral stress (radial, the same for x
+// and y), which can be held at a pressure or servoed to constant volume but not strained.
+class MembraneBoundary final : public BoundaryControl {
+ public:
+  explicit MembraneBoundary(Simulation& sim) : BoundaryControl(sim), walls_(sim) {}
+  void holdStress(int axis, double target) override {
+    checkAxis(axis);
+    if (axis == 2) return walls_.holdStress(2, target);
+    // x and y are the same radial stress (a test's lateral targets are equal: io/config.cpp).
+    sim_.membrane.control = MembraneControl::Pressure;
+    sim_.membrane.pressure = target;
+  }
+  void holdFaceStress(int axis, int side, double target) override {
+    if (axis == 2) return walls_.holdFaceStress(2, side, target);
+    holdStress(axis, target);
+  }
+  void imposeStrainRate(int axis, double rate, double factor) override {
+    checkAxis(axis);
+    if (axis != 2) refuse("a lateral strain rate");
+    // As the wall box's platens, on this boundary's reference height (walls_ keeps no reference).
+    const double speed = factor * (0.5 * rate * lengths0_[2]);
+    sim_.box.lower(2).control = WallControl::Velocity;
+    sim_.box.upper(2).control = WallControl::Velocity;
+    sim_.box.lower(2).velocity = speed;
+    sim_.box.upper(2).velocity = -speed;
+  }
+  void fix(int axis) override {
+    checkAxis(axis);
+    if (axis != 2) refuse("no lateral strain");
+    walls_.fix(2);
+  }
+  void constantVolume(int axis) override {
+    checkAxis(axis);
+    if (axis == 2) refuse("the platens at constant volume");
+    Membrane& m = sim_.membrane;
+    if (m.control != MembraneControl::ConstantVolume) m.basePressure = m.pressure;
+    m.control = MembraneControl::ConstantVolume;
+    m.referenceVolume = m.volume;
+  }
+  void holdShape() override {}
+  void freeShape() override {}
+  void imposeShearRate(double, double) override {
+    throw InputError("simple shear needs a periodic cell (test.boundary = \"periodic\"): a membrane sample has no shearing walls");
+  }
+  void setReference() override {
+    lengths0_ = lengths();
+    volume0_ = volume();
+  }
+  // The sleeve is unstretched: its hoop tension counts from here. (The flexible membrane replaced
+  // the rigid cylinder at the end of the preparation, Laboratory::installMembrane; a sample set up
+  // otherwise gets it here.)
+  void beginTest() override {
+    Membrane& m = sim_.membrane;
+    if (m.rigid) {
+      m.rigid = false;
+      m.servoIntegral = 0.0;
+      m.measure(sim_.particles, sim_.box.lower(2).position, sim_.box.upper(2).position);
+      m.applyPressure(sim_.particles);
+      sim_.refreshMembrane();
+    }
+    setReference();
+    m.referenceRadius = m.equivalentRadius();
+  }
+  Vec3 stress() const override {
+    const double r = sim_.membrane.radialStress();
+    return {r, r, 0.5 * (sim_.wallStress(WallBox::index(2, 0)) + sim_.wallStress(WallBox::index(2, 1)))};
+  }
+  std::array<double, 6> faceStresses() const override {
+    const double r = sim_.membrane.radialStress();
+    return {r, r, r, r, sim_.wallStress(WallBox::index(2, 0)), sim_.wallStress(WallBox::index(2, 1))};
+  }
+  // The diameter of the right cylinder of the enclosed volume, twice (x, y), and the height.
+  Vec3 lengths() const override {
+    const double d = 2.0 * sim_.membrane.equivalentRadius();
+    return {d, d, sim_.membrane.height};
+  }
+
+ private:
+  [[noreturn]] static void refuse(const char* what) {
+    throw InputError(fmt::format("test.boundary = \"membrane\": a membrane cannot impose {} (it holds a lateral "
+                                 "stress or a constant volume); allowed: test types whose lateral boundary holds a "
+                                 "stress: isotropic, triaxial, constant-p, cyclic-triaxial, stress-path", what));
+  }
+  WallBoundary walls_;
+};
+
 }  // namespace
 
 std::unique_ptr<BoundaryControl> BoundaryControl::of(Simulation& sim) {
   if (sim.boundary == Boundary::Periodic) return std::unique_ptr<BoundaryControl>(new CellBoundary(sim));
+  if (sim.boundary == Boundary::Membrane) return std::unique_ptr<BoundaryControl>(new MembraneBoundary(sim));
   return std::unique_ptr<BoundaryControl>(new WallBoundary(sim));
 }
 

@@ -30,6 +30,13 @@ Mat3 contactStress(const Simulation& sim) {
     if (c.wall) s -= c.force * c.branch.transpose();  // the wall's force on the particle, arm x^c - x^p
     else s += c.force * c.branch.transpose();
   });
+  // The membrane's forces act at the grains' outermost points, r along the outward radial.
+  const Membrane& m = sim.membrane;
+  if (sim.boundary == Boundary::Membrane)
+    for (std::size_t k = 0; k < m.grain.size(); ++k) {
+      const double f = m.force[k].norm();
+      if (f > 0.0) s -= m.force[k] * (-sim.particles.radius[m.grain[k]] / f * m.force[k]).transpose();
+    }
   return s / sim.volume();
 }
 
@@ -45,6 +52,8 @@ Mat3 unbalancedStress(const Simulation& sim) {
       net[c.a] -= c.force;
     }
   });
+  if (sim.boundary == Boundary::Membrane)
+    for (std::size_t k = 0; k < sim.membrane.grain.size(); ++k) net[sim.membrane.grain[k]] += sim.membrane.force[k];
   const Vec3 centre = 0.5 * (sim.box.lowerCorner() + sim.box.upperCorner());
   Mat3 u = Mat3::Zero();
   for (std::size_t i = 0; i < x.size(); ++i) u -= net[i] * (x[i] - centre).transpose();
@@ -53,6 +62,10 @@ Mat3 unbalancedStress(const Simulation& sim) {
 
 Vec3 boundaryStress(const Simulation& sim) {
   if (sim.boundary == Boundary::Periodic) return sim.cell.stress.diagonal();
+  if (sim.boundary == Boundary::Membrane) {
+    const double r = sim.membrane.radialStress();
+    return {r, r, 0.5 * (sim.wallStress(WallBox::index(2, 0)) + sim.wallStress(WallBox::index(2, 1)))};
+  }
   return {sim.box.stress(0), sim.box.stress(1), sim.box.stress(2)};
 }
 
@@ -60,11 +73,17 @@ std::array<double, 6> singleWallStresses(const Simulation& sim) {
   std::array<double, 6> s{};
   if (sim.boundary == Boundary::Walls)
     for (int k = 0; k < 6; ++k) s[k] = sim.box.wallStress(k);
+  if (sim.boundary == Boundary::Membrane)
+    for (int k = 0; k < 6; ++k) s[k] = k < 4 ? sim.membrane.radialStress() : sim.wallStress(k);
   return s;
 }
 
 Vec3 sampleLengths(const Simulation& sim) {
   if (sim.boundary == Boundary::Periodic) return sim.cell.h.diagonal();
+  if (sim.boundary == Boundary::Membrane) {
+    const double d = 2.0 * sim.membrane.equivalentRadius();
+    return {d, d, sim.membrane.height};
+  }
   return {sim.box.length(0), sim.box.length(1), sim.box.length(2)};
 }
 

@@ -13,7 +13,10 @@ namespace grainlab::lab {
 namespace {
 
 // Random sequential placement in the box [0, extent] (a periodic cell: the cube of side extent[0]).
-bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodic, Rng& rng, std::vector<Vec3>& pos) {
+// With cylinder > 0, only in the cylinder of that radius about the box's vertical centre line (a
+// draw outside it counts as a failed attempt).
+bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodic, Rng& rng, std::vector<Vec3>& pos,
+              double cylinder = 0.0) {
   const double rMax = radii.front();
   const double cellSide = 2.0 * rMax;
   const double boxSide = extent[0];  // the period of a cell
@@ -32,6 +35,7 @@ bool tryPlace(const std::vector<double>& radii, const Vec3& extent, bool periodi
       // earlier Vec3(u(), u(), u()), kept so that every seed places its grains where it did.
       Vec3 x;
       for (int a = 2; a >= 0; --a) x[a] = rng.uniform(periodic ? 0.0 : r, periodic ? boxSide : extent[a] - r);
+      if (cylinder > 0.0 && std::hypot(x[0] - 0.5 * extent[0], x[1] - 0.5 * extent[1]) > cylinder - r) continue;
       SpatialGrid::Cell c{};
       for (int a = 0; a < 3; ++a) c[a] = SpatialGrid::coordinate(x[a], 0.0, side, dim[a]);
       bool free = true;
@@ -120,6 +124,37 @@ void placeLoose(std::vector<double> diameters, double density, double voidRatio,
   addInCellOrder(pos, radii, Vec3::Constant(side), density, sim);
   if (periodic) sim.cell.setBox(Vec3::Constant(side));
   else sim.box.setBounds(Vec3::Zero(), Vec3::Constant(side));
+}
+
+CylinderPlacement placeCylinder(std::vector<double> diameters, double density, double voidRatio, double aspect,
+                                double binSide, double shrink, Rng& rng, Simulation& sim) {
+  const Grains g = largestFirst(std::move(diameters));
+  // pi R^2 (2 R aspect) = solid (1 + e)
+  double radius = std::max(std::cbrt(g.solid * (1.0 + voidRatio) / (2.0 * kPi * aspect)), 2.0 * g.dMax);
+  std::vector<Vec3> pos;
+  while (!tryPlace(g.radii, Vec3(2.0 * radius, 2.0 * radius, 2.0 * aspect * radius), false, rng, pos, radius))
+    radius *= 1.05;
+  const double height = 2.0 * aspect * radius;
+  addInCellOrder(pos, g.radii, Vec3(2.0 * radius, 2.0 * radius, height), density, sim);
+  // The lateral walls stand three radii off the axis: never touched (a grain past them has left the
+  // sample, an error), and the broad phase's grid spans the grains only.
+  sim.box.setBounds(Vec3(-2.0 * radius, -2.0 * radius, 0.0), Vec3(4.0 * radius, 4.0 * radius, height));
+  Membrane& m = sim.membrane;
+  m = Membrane{};
+  m.axisX = m.axisY = radius;
+  m.rigid = true;  // a rigid cylinder until the test begins
+  m.radius = radius;
+  m.around = std::max(8, static_cast<int>(std::lround(2.0 * kPi * radius * shrink / binSide)));
+  m.along = std::max(4, static_cast<int>(std::lround(height * shrink / binSide)));
+  // The loaded shell: half a mean grain radius deep.
+  double meanRadius = 0.0;
+  for (double r : g.radii) meanRadius += r;
+  m.shell = 0.5 * meanRadius / static_cast<double>(g.radii.size());
+  m.measure(sim.particles, 0.0, height);
+  CylinderPlacement out;
+  out.radius = radius;
+  out.height = height;
+  return out;
 }
 
 ColumnPlacement placeColumn(std::vector<double> diameters, double density, double voidRatio, double bedVoidRatio,

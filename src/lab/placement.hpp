@@ -15,6 +15,16 @@ namespace grainlab::lab {
 // as sim.boundary says.
 void placeLoose(std::vector<double> diameters, double density, double voidRatio, Rng& rng, Simulation& sim);
 
+// test.boundary = "membrane": spheres placed as placeLoose does, in a cylinder of height/diameter
+// `aspect` (the cloud at voidRatio), its axis vertical; the box's z walls (the platens) on its end
+// faces, its x and y walls well clear of it; the membrane's bins about binSide [m] square once the
+// sample has shrunk linearly by `shrink` (sim.membrane set up and measured).
+struct CylinderPlacement {
+  double radius = 0.0, height = 0.0;  // of the cloud [m]
+};
+CylinderPlacement placeCylinder(std::vector<double> diameters, double density, double voidRatio, double aspect,
+                                double binSide, double shrink, Rng& rng, Simulation& sim);
+
 // sample.method = "deposition": spheres placed at random, without overlaps, in a column (a cloud of
 // void ratio voidRatio) above the floor of a wall box with a square footprint on which a bed of
 // about bedVoidRatio would be a cube; the cloud's lowest point is dropHeight above the floor. The

@@ -13,6 +13,8 @@ namespace grainlab::lab {
 
 namespace {
 
+constexpr double kMembraneMinDiameterD50 = 8.0;
+
 // Finite and not subnormal (zero allowed where `zeroAllowed`).
 bool usable(double v, bool zeroAllowed) { return std::isfinite(v) && (std::abs(v) >= DBL_MIN || (zeroAllowed && v == 0.0)); }
 
@@ -92,6 +94,21 @@ void preflight(const RunConfig& config, const Simulation* packed) {
                                  static_cast<double>(have) / (1ull << 30), (have - std::min(have, estimatedRunBytes(0))) / kBytesPerParticle));
   Laboratory lab(config);
   lab.checkSample(packed);
+  if (lab.simulation().boundary == Boundary::Membrane) {
+    // A band 8-20 d50 thick (x-ray studies) needs room: refuse a cylinder under kMembraneMinDiameterD50
+    // across once compacted (the cloud shrinks to about (1 + e0) / (1 + e_placement) of its volume).
+    const double shrink = std::cbrt((1.0 + config.sample.e0) / (1.0 + config.sample.initialVoidRatio));
+    const double across = 2.0 * lab.simulation().membrane.radius * shrink / lab.d50();
+    if (across < kMembraneMinDiameterD50) {
+      const double need = static_cast<double>(config.sample.nParticles) * std::pow(kMembraneMinDiameterD50 / across, 3.0);
+      throw InputError(fmt::format(
+          "config error: sample.n_particles = {}: a membrane sample of {} grains would be about {:.1f} d50 across, too "
+          "small to hold a shear band; allowed: a diameter of at least {:g} d50, about {:.0f} grains or more at "
+          "test.aspect_ratio = {:g}",
+          config.sample.nParticles, config.sample.nParticles, across, kMembraneMinDiameterD50, std::ceil(need),
+          config.test.aspectRatio));
+    }
+  }
   checkDerived(config, lab.simulation());
   checkTestSteps(config, lab.simulation(), lab.d50());
 }

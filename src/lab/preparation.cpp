@@ -142,6 +142,10 @@ PreparationResult Laboratory::prepare() {
     }
   }
   sim_ = std::move(best);
+  if (sim_.boundary == Boundary::Membrane) {
+    result.steps += installMembrane();
+    result.e0 = voidRatio(sim_);
+  }
   result.growth = growthCurve_;
   result.deposition = deposition_;
   if (underCompaction_) {
@@ -196,6 +200,11 @@ void Laboratory::placeSample(PreparationResult& result) {
     placeLattice(n, result.grading.d50, config_.sample.density, sim_);
     result.grading = gradingStats(std::vector<double>(sim_.particles.size(), result.grading.d50));
     d50_ = result.grading.d50;
+  } else if (sim_.boundary == Boundary::Membrane) {
+    // The bins are sized for the compacted sample, about (1 + e0) / (1 + e_placement) of the cloud's volume.
+    const double shrink = std::cbrt((1.0 + config_.sample.e0) / (1.0 + config_.sample.initialVoidRatio));
+    placeCylinder(diameters, config_.sample.density, config_.sample.initialVoidRatio, config_.test.aspectRatio,
+                  config_.test.membraneBinD50 * d50_, shrink, rng, sim_);
   } else {
     placeLoose(diameters, config_.sample.density, config_.sample.initialVoidRatio, rng, sim_);
   }
@@ -213,6 +222,16 @@ void Laboratory::placeSample(PreparationResult& result) {
           "under twice the interaction range {:.3g} m); allowed: enough particles for >= ~3 largest "
           "diameters per side", config_.sample.nParticles, expected, need));
   }
+}
+
+long Laboratory::installMembrane() {
+  Membrane& m = sim_.membrane;
+  m.rigid = false;
+  m.servoIntegral = 0.0;
+  m.measure(sim_.particles, sim_.box.lower(2).position, sim_.box.upper(2).position);
+  m.applyPressure(sim_.particles);
+  sim_.refreshMembrane();
+  return consolidate(config_.test.confiningPressure, "equilibrium in the flexible membrane");
 }
 
 long Laboratory::settle(const std::string& phase, double work0) {

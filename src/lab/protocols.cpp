@@ -34,6 +34,10 @@ void configureSolver(const RunConfig& c, Simulation& sim) {
   sim.model.yadeMomentLimit = c.contact.momentLimit == "yade";
   sim.model.tanFriction = std::tan(degToRad(c.contact.frictionDeg));
   for (Wall& w : sim.box.walls) w.tanFriction = std::tan(degToRad(c.contact.wallFrictionDeg));
+  if (c.test.platenFrictionDeg)
+    for (int side = 0; side < 2; ++side) sim.box.walls[WallBox::index(2, side)].tanFriction = std::tan(degToRad(*c.test.platenFrictionDeg));
+  // The sleeve's hoop stiffness; it pulls only once a test has set its unstretched radius.
+  if (sim.boundary == Boundary::Membrane) sim.membrane.stiffness = c.test.membraneYoung * c.test.membraneThickness;
   sim.gravity = c.sample.gravity ? Vec3((*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]) : Vec3::Zero();
   sim.localDamping = c.solver.damping;
   sim.viscousDamping = c.solver.viscousDamping;
@@ -60,7 +64,9 @@ void holdIsotropicStress(Simulation& sim, double pressure) {
 
 Laboratory::Laboratory(const RunConfig& config, ProgressFn progress)
     : config_(config), progress_(std::move(progress)) {
-  sim_.boundary = config.test.boundary == "periodic" ? Boundary::Periodic : Boundary::Walls;
+  sim_.boundary = config.test.boundary == "periodic"   ? Boundary::Periodic
+                  : config.test.boundary == "membrane" ? Boundary::Membrane
+                                                       : Boundary::Walls;
   boundary_ = BoundaryControl::of(sim_);
   // Ellipsoid samples get the shape columns too (a_tau, a_E, ... of lab/micromechanics.hpp).
   microColumns_.nonSpherical = config.sample.shape.type == "ellipsoid";
@@ -256,13 +262,14 @@ GrainKinematics Laboratory::incrementKinematics() const {
 }
 
 GrainKinematics Laboratory::kinematicsSince(const GrainRecords& reference, const Vec3& l0) const {
-  // The sample's homogeneous Green–Lagrange strain since the reference: from the box lengths, or
-  // from the cell, F = H H_ref^-1.
+  // The sample's homogeneous Green–Lagrange strain since the reference: from the lengths of the
+  // box (a membrane sample's diameter and height), or from the cell, F = H H_ref^-1.
   Mat3 f = Mat3::Identity();
   if (sim_.boundary == Boundary::Periodic) {
     f = sim_.cell.h * reference.referenceCell.inverse();
   } else {
-    for (int a = 0; a < 3; ++a) f(a, a) = sim_.box.length(a) / l0[a];
+    const Vec3 l = sampleLengths(sim_);
+    for (int a = 0; a < 3; ++a) f(a, a) = l[a] / l0[a];
   }
   Mat3 boxStrain = Mat3::Zero();
   if (sim_.boundary == Boundary::Periodic) {
@@ -291,7 +298,7 @@ void Laboratory::closeBandWindow(Record& r, double strain) {
   st.previousWindowLengths = st.windowLengths;
   window_.reset(sim_);  // the moved-from record; only positions, orientations and the cell are read
   st.windowStrain = strain;
-  for (int a = 0; a < 3; ++a) st.windowLengths[a] = sim_.box.length(a);
+  st.windowLengths = sampleLengths(sim_);
 }
 
 std::optional<ShearBand> Laboratory::shearBand(const GrainKinematics& k) const {

@@ -358,6 +358,9 @@ class Laboratory {
   // cloud's top to the layer's target height), held there until at rest, the platen lifted for the
   // next. Fills underCompaction_.
   long underCompact();
+  // test.boundary = "membrane": the flexible membrane replaces the rigid cylinder the sample was
+  // prepared in, and the sample comes to equilibrium in it at the confining pressure.
+  long installMembrane();
   long settle(const std::string& phase, double work0);  // walls as they are, until at rest under gravity
   static constexpr long kTampSteps = 100000;
   std::vector<std::vector<double>> layerDiameters_;  // the grains of each layer (placeSample)

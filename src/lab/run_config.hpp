@@ -153,9 +153,18 @@ struct TestConfig {
   // test.drainage (triaxial, simple-shear, cyclic-triaxial): undrained = constant volume, the
   // change of total lateral stress the constraint produces read as the excess pore pressure u.
   Drainage drainage = Drainage::Drained;
-  std::string boundary = "walls";     // "walls" | "periodic"
+  std::string boundary = "walls";     // "walls" | "periodic" | "membrane"
   double confiningPressure = 100.0e3; // [Pa]; the mean stress of constant-p and true-triaxial, the
                                       // normal stress of simple-shear
+  // test.boundary = "membrane" (core/membrane.hpp, docs/physics.md §8.3): height/diameter of the
+  // cylinder, the sleeve's Young modulus [Pa] and thickness [m] (its hoop stiffness E_m t), and the
+  // side of the membrane's bins in d50.
+  double aspectRatio = 2.0;
+  double membraneYoung = 1.4e6;
+  double membraneThickness = 0.3e-3;
+  double membraneBinD50 = 1.0;
+  // Friction of the platens (the z walls) [deg]; nullopt: contact.wall_friction_deg, as every wall.
+  std::optional<double> platenFrictionDeg;
   std::optional<double> axialStrainRate = 0.5;  // [1/s]; nullopt = "auto"
   double finalAxialStrain = 0.20;     // [-]
   double b = 0.5;                     // true-triaxial: (sigma2 - sigma3)/(sigma1 - sigma3)

@@ -16,6 +16,29 @@ namespace grainlab::lab {
 
 namespace {
 
+// test.boundary = "membrane": how the membrane was set up and where it ended.
+Json membraneJson(const RunConfig& config, const Simulation& sim, double d50) {
+  const Membrane& m = sim.membrane;
+  Json j = Json::object();
+  j["model"] = "pressure on the outermost grains of bins of the lateral surface (core/membrane.hpp)";
+  j["bins_around"] = m.around;
+  j["bins_along"] = m.along;
+  j["bin_side_d50"] = config.test.membraneBinD50;
+  j["shell_d50"] = m.shell / d50;
+  j["aspect_ratio"] = config.test.aspectRatio;
+  j["young_Pa"] = config.test.membraneYoung;
+  j["thickness_m"] = config.test.membraneThickness;
+  j["reference_diameter_m"] = 2.0 * m.referenceRadius;
+  j["end_diameter_m"] = 2.0 * m.equivalentRadius();
+  j["end_height_m"] = m.height;
+  j["end_cell_pressure"] = m.pressure;
+  j["end_radial_stress"] = m.radialStress();
+  j["end_membrane_correction"] = m.hoopPressure;
+  j["end_filled_bins_fraction"] = m.around * m.along > 0 ? static_cast<double>(m.filledBins) / (m.around * m.along) : 0.0;
+  j["platen_friction_deg"] = config.test.platenFrictionDeg.value_or(config.contact.wallFrictionDeg);
+  return j;
+}
+
 // JSON number that refuses NaN/inf (results never carry them silently).
 double finite(double v, const char* name) {
   if (!std::isfinite(v)) throw SimulationError(fmt::format("non-finite result {}", name));
@@ -294,6 +317,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   // Simple shear has no lateral stress target: not measured.
   s["lateral_stress_max_deviation"] = simpleShear ? Json(nullptr) : Json(shear.maxLateralDeviation);
   if (config.test.boundary == "walls") s["lateral_stress_max_deviation_single_wall"] = shear.maxSingleWallDeviation;
+  if (config.test.boundary == "membrane") s["membrane"] = membraneJson(config, lab.simulation(), lab.d50());
   s["shear_pipeline"] = lab.shearStageNames();
   if (shear.maxLateralDeviation > 0.02)
     out.warnings.push_back(

@@ -143,7 +143,7 @@ void Laboratory::beginShear() {
   // The first band window starts here.
   window_ = records_;
   previousWindow_ = records_;
-  for (int a = 0; a < 3; ++a) st.windowLengths[a] = sim_.box.length(a);
+  st.windowLengths = sampleLengths(sim_);
   st.previousWindowLengths = st.windowLengths;
   sim_.energy = EnergyLedger{};
   st.elastic0 = elasticEnergy(sim_);

@@ -123,6 +123,7 @@ def test_documented_defaults_are_what_check_prints(grainlab, tmp_path):
         "hertz-mindlin": '[contact]\nmodel = "hertz-mindlin"\n',
         "deposition": '[sample]\nmethod = "deposition"\n',
         "under-compaction": '[sample]\nmethod = "under-compaction"\n',
+        "membrane": '[sample]\nn_particles = 3000\n[test]\nboundary = "membrane"\nplaten_friction_deg = 0.0\n',
     }
     printed = {}
     for name, text in configs.items():
@@ -225,6 +226,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "growth_curve",                        # ellipsoid shape growth
     "deposition",                          # sample.method = "deposition"
     "under_compaction",                    # sample.method = "under-compaction"
+    "membrane",                            # test.boundary = "membrane"
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
     # undrained tests

@@ -29,7 +29,7 @@ NUMBER_KEYS = [
     "test.final_axial_strain", "solver.damping", "solver.dt_factor", "solver.dt", "solver.unbalanced_tolerance",
     "solver.stress_tolerance", "solver.servo_gain", "solver.servo_integral_steps", "solver.servo_max_speed", "test.servo_max_speed",
     "solver.skin_fraction", "output.record_every_strain", "output.checkpoint_every", "output.vtk_every_strain",
-    "output.band_factor", "output.band_strain_window",
+    "output.band_factor", "output.band_strain_window", "test.platen_friction_deg",
 ]
 INTEGER_KEYS = ["sample.n_particles", "sample.seed", "sample.prep_ramp_steps", "solver.threads", "solver.max_steps"]
 CHOICE_KEYS = {"contact.model": ["kozicki", "rolling-linear"], "test.type": ["isotropic", "triaxial"],

@@ -84,9 +84,9 @@ static_assert(sizeof(ContactStore) ==
 static_assert(stateio::fieldCount<PeriodicCell>() == 16, "PeriodicCell changed: update Simulation::saveCell/loadCell");
 static_assert(stateio::fieldCount<lab::GrainRecords>() == 5, "GrainRecords changed: update its saveState/loadState");
 static_assert(sizeof(Simulation) ==
-                  layoutSize<Particles, Boundary, WallBox, PeriodicCell, ContactStore, BroadPhase,
+                  layoutSize<Particles, Boundary, WallBox, PeriodicCell, Membrane, ContactStore, BroadPhase,
                              contact::SphereContactModel, ServoSettings, EnergyLedger, Vec3, double, double, double,
-                             long, double, bool, std::vector<geometry::Sym3>, ChunkedSums, ChunkedSums, ChunkedSums,
+                             long, double, std::vector<Vec3>, bool, std::vector<geometry::Sym3>, ChunkedSums, ChunkedSums, ChunkedSums,
                              ChunkedSums, ChunkedSums, ChunkedSums, std::array<bool, 5>, StageFlag,
                              std::exception_ptr>(),
               "Simulation changed: update Simulation::saveState/loadState and this list (shape matrices, the "
