@@ -44,6 +44,10 @@ CASES = {
     "stress-path-b": ("preset:stress-path-b", ["--set", "sample.n_particles=300", "--set", "test.probe_strain=0"]),
     "stress-path-constant-p": ("preset:stress-path-constant-p",
                                ["--set", "sample.n_particles=300", "--set", "test.probe_strain=0"]),
+    # 2700 grains: about the smallest membrane sample of this grading preflight allows (8 d50 across).
+    "membrane-triaxial": ("preset:membrane-triaxial",
+                          ["--set", "sample.n_particles=2700", "--set", "test.final_axial_strain=0.004",
+                           "--set", "test.probe_strain=0"]),
     # Tests, laws and preparations no preset runs.
     "undrained-triaxial": ("preset:quick-triaxial", SHORT + ["--set", 'test.drainage="undrained"']),
     "oedometer": ("preset:quick-triaxial",
