@@ -7,6 +7,25 @@ namespace grainlab {
 
 double Membrane::equivalentRadius() const { return height > 0.0 ? std::sqrt(volume / (kPi * height)) : 0.0; }
 
+bool Membrane::contains(const Vec3& x) const {
+  if (around <= 0 || along <= 0 || !(height > 0.0) || x[2] < bottom || x[2] > bottom + height) return false;
+  const double dx = x[0] - axisX, dy = x[1] - axisY;
+  const double dTheta = 2.0 * kPi / around, dz = height / along;
+  const int a = std::clamp(static_cast<int>(std::floor((std::atan2(dy, dx) + kPi) / dTheta)), 0, around - 1);
+  const int k = std::clamp(static_cast<int>(std::floor((x[2] - bottom) / dz)), 0, along - 1);
+  const std::size_t b = static_cast<std::size_t>(k) * static_cast<std::size_t>(around) + static_cast<std::size_t>(a);
+  if (b >= binRho.size()) return false;
+  double rho = binRho[b];
+  if (binGrain[b] < 0) {  // the mean of the filled bins, as measure() takes it
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t c = 0; c < binRho.size(); ++c)
+      if (binGrain[c] >= 0) sum += binRho[c], ++n;
+    rho = n > 0 ? sum / n : 0.0;
+  }
+  return std::hypot(dx, dy) <= rho;
+}
+
 void Membrane::measure(const Particles& particles, double zLow, double zHigh) {
   const std::size_t bins = static_cast<std::size_t>(around) * static_cast<std::size_t>(along);
   binRho.assign(bins, 0.0);

@@ -89,6 +89,9 @@ struct Membrane {
 
   // The radial stress the membrane puts on the sample [Pa]: cell pressure plus the hoop term.
   double radialStress() const { return area > 0.0 ? radialForce / area : 0.0; }
+  // Whether a point is inside the membrane as last measured (its bin's radius; an empty bin's the
+  // mean) and between the platens: the region whose volume is `volume`.
+  bool contains(const Vec3& x) const;
   // Mean radius of a right cylinder of the enclosed volume and height, sqrt(V / (pi H)) [m].
   double equivalentRadius() const;
   // The platens' area [m^2]: the rigid cylinder's cross-section, or the flexible membrane's mean

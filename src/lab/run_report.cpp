@@ -357,7 +357,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
       "lie in a slab (smallest/middle eigenvalue of their position covariance <= 0.25); its plane fitted to the "
       "centroids of full columns of them along the normal, inclination_deg = the plane's angle to the horizontal, "
       "thickness_d50 = full width at half height of the mean eq profile across it (bins of d50) above the "
-      "background (the median eq outside); void_ratio_inside/outside: the box's volume and the grains' solid (by "
+      "background (the median eq outside); void_ratio_inside/outside: the box's volume (a membrane sample's: inside the membrane) and the grains' solid (by "
       "spherical caps, exact for spheres) within and beyond the slab of that thickness at the end; shear_band is "
       "the last window's band (detected false: none found there; null: no window closed, or a periodic cell, "
       "where a band may wrap across the faces); onset_eps1 = the end of the first window from which every window "
@@ -586,8 +586,16 @@ Json shearBandJson(const std::optional<ShearBand>& b, bool measured, const Simul
       none[key] = nullptr;
     return none;
   }
-  const std::optional<BandVoidRatios> e = bandVoidRatios(*b, sim.particles.position, sim.particles.semiAxes,
-                                                          sim.box.lowerCorner(), sim.box.upperCorner());
+  // A membrane sample: the cylinder inside the membrane, not the box around it.
+  const bool membrane = sim.boundary == Boundary::Membrane;
+  const Membrane& m = sim.membrane;
+  const double reach = membrane && !m.binRho.empty() ? *std::max_element(m.binRho.begin(), m.binRho.end()) : 0.0;
+  const Vec3 lo = membrane ? Vec3(m.axisX - reach, m.axisY - reach, m.bottom) : sim.box.lowerCorner();
+  const Vec3 hi = membrane ? Vec3(m.axisX + reach, m.axisY + reach, m.bottom + m.height) : sim.box.upperCorner();
+  const std::optional<BandVoidRatios> e =
+      bandVoidRatios(*b, sim.particles.position, sim.particles.semiAxes, lo, hi,
+                     membrane ? std::function<bool(const Vec3&)>([&m](const Vec3& x) { return m.contains(x); })
+                              : std::function<bool(const Vec3&)>());
   return {{"detected", true},
           {"inclination_deg", finite(b->inclinationDeg, "shear_band.inclination_deg")},
           {"onset_eps1", optional(onset)},

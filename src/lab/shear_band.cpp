@@ -165,7 +165,8 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
 }
 
 std::optional<BandVoidRatios> bandVoidRatios(const ShearBand& band, const std::vector<Vec3>& position,
-                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi) {
+                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi,
+                                             const std::function<bool(const Vec3&)>& inSample) {
   if (position.size() != semiAxes.size() || !(band.thickness > 0.0) || !((hi - lo).minCoeff() > 0.0))
     return std::nullopt;
   const double h = 0.5 * band.thickness;
@@ -184,15 +185,19 @@ std::optional<BandVoidRatios> bandVoidRatios(const ShearBand& band, const std::v
   }
   constexpr int kGrid = 128;
   const Vec3 step = (hi - lo) / kGrid;
-  long inside = 0;
+  long inside = 0, sample = 0;
   for (int i = 0; i < kGrid; ++i)
     for (int j = 0; j < kGrid; ++j)
       for (int k = 0; k < kGrid; ++k) {
         const Vec3 x = lo + Vec3((i + 0.5) * step.x(), (j + 0.5) * step.y(), (k + 0.5) * step.z());
+        if (inSample && !inSample(x)) continue;
+        ++sample;
         inside += std::abs(band.normal.dot(x - band.centre)) <= h;
       }
-  const double volume = (hi - lo).prod();
-  const double slab = volume * static_cast<double>(inside) / (static_cast<double>(kGrid) * kGrid * kGrid);
+  const double cell = (hi - lo).prod() / (static_cast<double>(kGrid) * kGrid * kGrid);
+  const double volume = inSample ? cell * static_cast<double>(sample) : (hi - lo).prod();
+  const double slab = inSample ? cell * static_cast<double>(inside)
+                               : volume * static_cast<double>(inside) / (static_cast<double>(kGrid) * kGrid * kGrid);
   if (!(solidIn > 0.0) || !(solid - solidIn > 0.0)) return std::nullopt;
   return BandVoidRatios{slab / solidIn - 1.0, (volume - slab) / (solid - solidIn) - 1.0};
 }

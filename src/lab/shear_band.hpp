@@ -22,6 +22,7 @@
 // The positions are those of a wall box; in a periodic cell a band may wrap across the faces and a
 // single plane does not describe it (the report leaves it null there).
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <tuple>
 #include <vector>
@@ -67,7 +68,10 @@ std::optional<ShearBand> findShearBand(const std::vector<Vec3>& position, const 
 struct BandVoidRatios {
   double inside = 0.0, outside = 0.0;
 };
+// `inSample` (when given) says which points of the box [lo, hi] belong to the sample (a membrane
+// sample's cylinder); otherwise the whole box does.
 std::optional<BandVoidRatios> bandVoidRatios(const ShearBand& band, const std::vector<Vec3>& position,
-                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi);
+                                             const std::vector<Vec3>& semiAxes, const Vec3& lo, const Vec3& hi,
+                                             const std::function<bool(const Vec3&)>& inSample = {});
 
 }  // namespace grainlab::lab

@@ -150,4 +150,20 @@ TEST(ShearBand, VoidRatiosInsideAndOutsideTheBand) {
   ASSERT_TRUE(loose);
   EXPECT_NEAR(loose->inside, 1.0 / (4.0 / 3.0 * M_PI * 0.064) - 1.0, 0.12);
   EXPECT_NEAR(loose->outside, sc, 0.03);
+  // A membrane sample: only the points the predicate keeps are the sample. The lattice's cylinder
+  // of radius 10 d about the box's axis (its grains only) in a box twice as wide: the same void
+  // ratios as the lattice, where counting the empty box around it would make them far looser.
+  std::vector<Vec3> inCylinder, cylinderAxes;
+  const Vec3 axis(12.0 * kD, 12.0 * kD, 0.0);
+  auto within = [&](const Vec3& x) { return std::hypot(x.x() - axis.x(), x.y() - axis.y()) <= 10.0 * kD; };
+  for (std::size_t i = 0; i < position.size(); ++i)
+    if (within(position[i])) inCylinder.push_back(position[i]), cylinderAxes.push_back(axes[i]);
+  const Vec3 wideLo = Vec3(-12, -12, 0) * kD, wideHi = Vec3(36, 36, 48) * kD;
+  const auto cylinder = lab::bandVoidRatios(band, inCylinder, cylinderAxes, wideLo, wideHi, within);
+  ASSERT_TRUE(cylinder);
+  EXPECT_NEAR(cylinder->inside, sc, 0.05);
+  EXPECT_NEAR(cylinder->outside, sc, 0.05);
+  const auto box = lab::bandVoidRatios(band, inCylinder, cylinderAxes, wideLo, wideHi);
+  ASSERT_TRUE(box);
+  EXPECT_GT(box->outside, 3.0 * sc);
 }
