@@ -92,9 +92,9 @@ def figures(runs):
         ax[1].plot(e, [100 * x["eps_v"] for x in r], color=colours[case], lw=1, label=lab)
         if case == "membrane":
             ax[2].plot(e, [x["rotation_band_mean_deg"] if x["rotation_band_mean_deg"] is not None else math.nan for x in r],
-                       color="tab:blue", lw=1, label=f"inside the band, seed {seed}")
+                       color="tab:blue", lw=1, label=f"in the band flag (eq >= band_factor x sample's), seed {seed}")
             ax[2].plot(e, [x["rotation_outside_band_mean_deg"] if x["rotation_outside_band_mean_deg"] is not None else math.nan
-                           for x in r], color="tab:green", lw=1, label=f"outside, seed {seed}")
+                           for x in r], color="tab:green", lw=1, label=f"the other grains, seed {seed}")
     ax[0].set_ylabel("deviator q [kPa]")
     ax[1].set_ylabel("volumetric strain eps_v [%] (contraction +)")
     ax[2].set_ylabel("mean grain rotation [deg] (membrane)")
@@ -138,7 +138,7 @@ def report(args):
             f"{num(b.get('inclination_deg'))} | {num(mc)} / {num(roscoe)} / {num(arthur)} | {num(b.get('thickness_d50'))} | "
             f"{num(100 * onset if onset is not None else None)} ({num(b.get('onset_over_peak'), '{:.2f}')}) | "
             f"{num(b.get('void_ratio_inside'), '{:.3f}')} / {num(b.get('void_ratio_outside'), '{:.3f}')} | "
-            f"{s.get('steps')} | {num(s.get('wall_seconds') / 60 if s.get('wall_seconds') else None, '{:.1f}')} min |")
+            f"{s.get('steps')} | {num(s.get('wall_seconds') / 60 if s.get('wall_seconds') else None, '{:.1f}')} min on {s['threads_used'] if 'threads_used' in s else str(s.get('threads')) + ' requested'} thread(s) |")
     lines += ["", "Band windows of each run (ε1 at the window's end: inclination / thickness in d50, or — where none "
               "was found):", ""]
     for (case, seed), (s, r) in sorted(runs.items()):
@@ -148,6 +148,14 @@ def report(args):
         lines.append(f"- {case}, seed {seed}: " + "; ".join(cells))
     lines += ["", END]
     figures(runs)
+    # The last band window's strain increment through the axis of each boundary's first seed.
+    import shutil
+    for case in CASES:
+        seeds = sorted(seed for c, seed in runs if c == case)
+        if seeds:
+            src = os.path.join(run_dir(case, seeds[0]), "plots", "band_slice.png")
+            if os.path.exists(src):
+                shutil.copyfile(src, os.path.join(ROOT, "docs", "results", f"shear-bands-slice-{case}.png"))
     with open(PAGE) as f:
         page = f.read()
     a, b = page.index(BEGIN), page.index(END) + len(END)

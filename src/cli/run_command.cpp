@@ -477,6 +477,9 @@ int runResolved(const lab::RunConfig& requested, const RunOptions& opt, const la
       summary["drainage"] = config.test.drainage == lab::Drainage::Undrained ? "undrained" : "drained";
     summary["e0_target"] = config.sample.e0;
     summary["threads"] = config.solver.threads;
+    // What the run had: fewer than requested where other processes kept cores busy (useThreads);
+    // the wall time and the speed are for this count.
+    summary["threads_used"] = omp_get_max_threads();
     summary["simd_target"] = kernels::simdTarget();  // GRAINLAB_SIMD; the results do not depend on it
     for (const auto& w : config.warnings) summary["warnings"].push_back(w);
     RunSession session(config, folder, opt.quiet, summary, 0.0, {}, {}, observer);
@@ -562,8 +565,10 @@ int resumeLab(const ResumeOptions& opt) {
   checkCheckpointBelongsToFolder(checkpoint.record["summary"], dir, stateFile);
   useThreads(config.solver.threads);
   const json& record = checkpoint.record;
+  json summary = record["summary"];
+  summary["threads_used"] = omp_get_max_threads();  // this session's (the wall time spans both)
   // Checkpoints of runs before the micromechanics snapshots have no list: the run numbers from 0.
-  RunSession session(config, folder, opt.quiet, record["summary"], record["wall_seconds"].get<double>(),
+  RunSession session(config, folder, opt.quiet, summary, record["wall_seconds"].get<double>(),
                      record["vtk_labels"].get<std::vector<double>>(),
                      record.contains("micro_snapshots")
                          ? io::microSnapshotsFromJson(record["micro_snapshots"], fmt::format("resume {}", io::quotedPath(opt.dir)))

@@ -5,7 +5,7 @@ import json
 import os
 
 DETERMINISM_SETS = ["--set", "sample.n_particles=120", "--set", "test.final_axial_strain=0.01"]
-VOLATILE = {"wall_seconds", "particle_steps_per_s", "threads", "config_source", "run_id"}
+VOLATILE = {"wall_seconds", "particle_steps_per_s", "threads_used", "threads", "config_source", "run_id"}
 
 
 def run(grainlab, data_dir, out, threads):

@@ -94,7 +94,7 @@ def test_cyclic_triaxial_cycles_between_the_amplitudes(tmp_path, drainage):
         assert s["ru_max"] is None and "u" not in c
 
 
-VOLATILE = {"wall_seconds", "particle_steps_per_s", "run_id"}
+VOLATILE = {"wall_seconds", "particle_steps_per_s", "threads_used", "run_id"}
 
 
 @pytest.mark.parametrize("test", [

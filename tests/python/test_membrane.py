@@ -110,7 +110,7 @@ def test_membrane_kill_and_resume_is_bit_identical(tmp_path):
     assert not (cut / "summary.json").exists()
     assert subprocess.run([GRAINLAB, "resume", str(cut), "--quiet"], timeout=900).returncode == 0
     assert (whole / "timeseries.csv").read_text() == (cut / "timeseries.csv").read_text()
-    volatile = {"wall_seconds", "particle_steps_per_s", "run_id"}
+    volatile = {"wall_seconds", "particle_steps_per_s", "threads_used", "run_id"}
     a, b = (json.loads((d / "summary.json").read_text()) for d in (whole, cut))
     assert {k: v for k, v in a.items() if k not in volatile} == {k: v for k, v in b.items() if k not in volatile}
 

@@ -10,7 +10,7 @@ SETS = ["--set", "sample.n_particles=150", "--set", "test.final_axial_strain=0.0
         "--set", "output.checkpoint_every=0.004", "--set", "output.vtk_every_strain=0.01",
         "--set", "output.band_strain_window=0.003",  # windows close before the kill, and after it
         "--set", "output.plots=false", "--threads", "2", "--quiet"]
-VOLATILE = {"wall_seconds", "particle_steps_per_s", "run_id"}
+VOLATILE = {"wall_seconds", "particle_steps_per_s", "threads_used", "run_id"}
 
 
 def outputs(out):
