@@ -7,13 +7,18 @@ namespace grainlab {
 
 double Membrane::equivalentRadius() const { return height > 0.0 ? std::sqrt(volume / (kPi * height)) : 0.0; }
 
+std::size_t Membrane::binOf(const Vec3& x) const {
+  const double dTheta = 2.0 * kPi / around, dz = height / along;
+  const int a = std::clamp(static_cast<int>(std::floor((std::atan2(x[1] - axisY, x[0] - axisX) + kPi) / dTheta)), 0,
+                           around - 1);
+  const int k = std::clamp(static_cast<int>(std::floor((x[2] - bottom) / dz)), 0, along - 1);
+  return static_cast<std::size_t>(k) * static_cast<std::size_t>(around) + static_cast<std::size_t>(a);
+}
+
 bool Membrane::contains(const Vec3& x) const {
   if (around <= 0 || along <= 0 || !(height > 0.0) || x[2] < bottom || x[2] > bottom + height) return false;
   const double dx = x[0] - axisX, dy = x[1] - axisY;
-  const double dTheta = 2.0 * kPi / around, dz = height / along;
-  const int a = std::clamp(static_cast<int>(std::floor((std::atan2(dy, dx) + kPi) / dTheta)), 0, around - 1);
-  const int k = std::clamp(static_cast<int>(std::floor((x[2] - bottom) / dz)), 0, along - 1);
-  const std::size_t b = static_cast<std::size_t>(k) * static_cast<std::size_t>(around) + static_cast<std::size_t>(a);
+  const std::size_t b = binOf(x);
   if (b >= binRho.size()) return false;
   double rho = binRho[b];
   if (binGrain[b] < 0) {  // the mean of the filled bins, as measure() takes it
@@ -43,9 +48,7 @@ void Membrane::measure(const Particles& particles, double zLow, double zHigh) {
   for (std::size_t i = 0; i < x.size(); ++i) {
     const double dx = x[i][0] - axisX, dy = x[i][1] - axisY;
     const double rho = std::hypot(dx, dy) + r[i];
-    const int a = std::clamp(static_cast<int>(std::floor((std::atan2(dy, dx) + kPi) / dTheta)), 0, around - 1);
-    const int k = std::clamp(static_cast<int>(std::floor((x[i][2] - zLow) / dz)), 0, along - 1);
-    const std::size_t b = static_cast<std::size_t>(k) * static_cast<std::size_t>(around) + static_cast<std::size_t>(a);
+    const std::size_t b = binOf(x[i]);
     if (rho > binRho[b]) {  // strict: the lowest index wins a tie, whatever the order of equal rho
       binRho[b] = rho;
       binGrain[b] = static_cast<std::int64_t>(i);
@@ -102,9 +105,7 @@ void Membrane::applyPressure(const Particles& particles) {
   for (std::size_t i = 0; i < x.size(); ++i) {
     const double dx = x[i][0] - axisX, dy = x[i][1] - axisY;
     const double rho = std::hypot(dx, dy) + r[i];
-    const int a = std::clamp(static_cast<int>(std::floor((std::atan2(dy, dx) + kPi) / dTheta)), 0, around - 1);
-    const int k = std::clamp(static_cast<int>(std::floor((x[i][2] - bottom) / dz)), 0, along - 1);
-    const std::size_t b = static_cast<std::size_t>(k) * static_cast<std::size_t>(around) + static_cast<std::size_t>(a);
+    const std::size_t b = binOf(x[i]);
     const double depth = binRho[b] - rho;
     const double w = shell > 0.0 ? 1.0 - depth / shell : (binGrain[b] == static_cast<std::int64_t>(i) ? 1.0 : 0.0);
     if (!(w > 0.0) || !(std::hypot(dx, dy) > 0.0)) continue;  // too deep, or on the axis (no radial direction)

@@ -89,6 +89,8 @@ struct Membrane {
 
   // The radial stress the membrane puts on the sample [Pa]: cell pressure plus the hoop term.
   double radialStress() const { return area > 0.0 ? radialForce / area : 0.0; }
+  // The bin of a point between the platens of the last measure() (theta fastest).
+  std::size_t binOf(const Vec3& x) const;
   // Whether a point is inside the membrane as last measured (its bin's radius; an empty bin's the
   // mean) and between the platens: the region whose volume is `volume`.
   bool contains(const Vec3& x) const;

@@ -389,6 +389,14 @@ void Simulation::membraneStage() {
   });
 }
 
+void Simulation::installFlexibleMembrane() {
+  membrane.rigid = false;
+  membrane.servoIntegral = 0.0;
+  membrane.measure(particles, box.lower(2).position, box.upper(2).position);
+  membrane.applyPressure(particles);
+  refreshMembrane();
+}
+
 void Simulation::refreshMembrane() {
   if (membraneLoad_.size() != particles.size()) membraneLoad_.assign(particles.size(), Vec3::Zero());
   for (std::size_t k = 0; k < membrane.grain.size(); ++k) membraneLoad_[membrane.grain[k]] = membrane.force[k];

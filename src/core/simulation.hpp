@@ -140,6 +140,9 @@ class Simulation {
   // The membrane's grains and forces of the current step, from its lists (after a load or a change
   // made outside step()).
   void refreshMembrane();
+  // The flexible membrane replaces the rigid cylinder of the preparation, its loads measured from
+  // the current positions.
+  void installFlexibleMembrane();
   // Number of touching particle–particle contacts at the latest step.
   std::size_t touchingPairs() const;
 

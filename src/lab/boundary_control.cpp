@@ -193,13 +193,7 @@ class MembraneBoundary final : public BoundaryControl {
   // otherwise gets it here.)
   void beginTest() override {
     Membrane& m = sim_.membrane;
-    if (m.rigid) {
-      m.rigid = false;
-      m.servoIntegral = 0.0;
-      m.measure(sim_.particles, sim_.box.lower(2).position, sim_.box.upper(2).position);
-      m.applyPressure(sim_.particles);
-      sim_.refreshMembrane();
-    }
+    if (m.rigid) sim_.installFlexibleMembrane();
     setReference();
     m.referenceRadius = m.equivalentRadius();
   }

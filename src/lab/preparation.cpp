@@ -225,12 +225,7 @@ void Laboratory::placeSample(PreparationResult& result) {
 }
 
 long Laboratory::installMembrane() {
-  Membrane& m = sim_.membrane;
-  m.rigid = false;
-  m.servoIntegral = 0.0;
-  m.measure(sim_.particles, sim_.box.lower(2).position, sim_.box.upper(2).position);
-  m.applyPressure(sim_.particles);
-  sim_.refreshMembrane();
+  sim_.installFlexibleMembrane();
   return consolidate(config_.test.confiningPressure, "equilibrium in the flexible membrane");
 }
 
