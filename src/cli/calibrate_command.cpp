@@ -45,7 +45,7 @@ constexpr std::size_t kMaxCurveRows = 100000;
 
 // A value or path for a message, within 80 characters: a long one keeps its start and its end
 // (a path's file name, which says which file is meant) around "...".
-std::string cut(std::string s) {
+std::string cutMiddle(std::string s) {
   for (char& c : s)
     if (c == '\n' || c == '\r') c = ' ';
   return s.size() > 80 ? s.substr(0, 38) + "..." + s.substr(s.size() - 39) : s;
@@ -64,7 +64,7 @@ std::string quoted(const std::vector<std::string>& names) {
 }
 
 [[noreturn]] void bad(const std::string& where, const std::string& value, const std::string& allowed) {
-  throw InputError(fmt::format("target error: {} = {}: {}", where, cut(value), allowed));
+  throw InputError(fmt::format("target error: {} = {}: {}", where, cutMiddle(value), allowed));
 }
 
 // One table of the target file: typed getters. A misspelt key is an error, not silently ignored,
@@ -516,17 +516,17 @@ int runCalibrate(const CalibrateOptions& opt) {
   const lab::RunConfig config = io::parseConfig(base, baseDir);
   if (config.test.type != lab::TestType::Triaxial)
     throw InputError(fmt::format("calibrate {}: test.type = \"{}\": calibration fits a triaxial test (test.type = \"triaxial\")",
-                                 cut(opt.config), lab::name(config.test.type)));
+                                 cutMiddle(opt.config), lab::name(config.test.type)));
 
   const fs::path targetPath = opt.target;
   std::error_code ec;
   if (!fs::is_regular_file(targetPath, ec))
-    throw InputError(fmt::format("--target {}: not found or not a regular file", cut(opt.target)));
+    throw InputError(fmt::format("--target {}: not found or not a regular file", cutMiddle(opt.target)));
   toml::table root;
   try {
     root = toml::parse_file(opt.target);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("target error: {} line {}: {}", cut(opt.target), e.source().begin.line, e.description()));
+    throw InputError(fmt::format("target error: {} line {}: {}", cutMiddle(opt.target), e.source().begin.line, e.description()));
   }
   static const std::vector<std::string> sections{"parameter", "target", "curve", "evaluation", "optimizer",
                                                  "sensitivity", "execution"};
@@ -576,14 +576,14 @@ int runCalibrate(const CalibrateOptions& opt) {
       std::ifstream in(inputsFile);
       in >> previous;
     } catch (const json::exception&) {
-      throw InputError(fmt::format("--out {}: calibration.json there is not readable JSON; use another folder", cut(out.string())));
+      throw InputError(fmt::format("--out {}: calibration.json there is not readable JSON; use another folder", cutMiddle(out.string())));
     }
     // A folder resumes only the calibration it holds: same config (resolved) and same target.
     for (const char* key : {"format", "config_resolved", "target"})
       if (previous.value(key, json()) != inputs[key])
         throw InputError(fmt::format("--out {}: holds a calibration with another {} ({}); resume with the same "
                                      "config and target, or choose another --out",
-                                     cut(out.string()), std::string(key) == "target" ? "target" : "config",
+                                     cutMiddle(out.string()), std::string(key) == "target" ? "target" : "config",
                                      std::string(key) == "target" ? previous.value("target_file", "?") : previous.value("config", "?")));
   } else {
     io::writeFileAtomic(inputsFile, inputs.dump(1) + "\n");

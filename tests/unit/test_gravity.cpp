@@ -16,17 +16,17 @@ using namespace grainlab;
 
 namespace {
 
-constexpr double kR = 1e-3, kRho = 2600.0, kG = 9.81, kL = 0.01;
+constexpr double kGravR = 1e-3, kGravRho = 2600.0, kGravity = 9.81, kL = 0.01;
 
-double sphereMass() { return kRho * 4.0 / 3.0 * kPi * kR * kR * kR; }
+double sphereMass() { return kGravRho * 4.0 / 3.0 * kPi * kGravR * kGravR * kGravR; }
 
 Simulation column(int n, double damping) {
   Simulation sim = scenes::emptyScene(kL);
-  sim.gravity = Vec3(0.0, 0.0, -kG);
+  sim.gravity = Vec3(0.0, 0.0, -kGravity);
   sim.localDamping = damping;
   sim.model.young = 3e7;  // soft: a longer time step, the same statics
   // Touching (no overlap): each sphere sinks into the one below by its share of the weight.
-  for (int k = 0; k < n; ++k) sim.particles.addSphere(Vec3(0.0, 0.0, -kL + kR + 2.0 * kR * k), kR, kRho);
+  for (int k = 0; k < n; ++k) sim.particles.addSphere(Vec3(0.0, 0.0, -kL + kGravR + 2.0 * kGravR * k), kGravR, kGravRho);
   sim.initialise();
   sim.dt = 0.2 * sim.criticalTimeStep();
   return sim;
@@ -39,7 +39,7 @@ double floorForce(const Simulation& sim) { return sim.box.walls[WallBox::index(2
 TEST(Gravity, SphereAtRestOnTheFloorCarriesItsWeight) {
   Simulation sim = column(1, 0.3);
   for (int i = 0; i < 20000; ++i) sim.step();
-  const double mg = sphereMass() * kG;
+  const double mg = sphereMass() * kGravity;
   EXPECT_NEAR(floorForce(sim) / mg, 1.0, 1e-6);
   EXPECT_NEAR(sim.particles.velocity[0].norm(), 0.0, 1e-6);
   // The walls that hold nothing carry nothing.
@@ -51,7 +51,7 @@ TEST(Gravity, ColumnCarriesTheWeightAboveEachContact) {
   constexpr int n = 6;
   Simulation sim = column(n, 0.3);
   for (int i = 0; i < 60000; ++i) sim.step();
-  const double mg = sphereMass() * kG;
+  const double mg = sphereMass() * kGravity;
   EXPECT_NEAR(floorForce(sim) / (n * mg), 1.0, 1e-6);
   int seen = 0;
   forEachTouchingContact(sim, [&](const ContactView& c) {
@@ -81,14 +81,14 @@ TEST(Gravity, UndampedDropClosesTheEnergyBalance) {
     sim.step();
     const double z = sim.particles.position[0].z();
     // Gravity's work is m g times the fall, to round-off.
-    ASSERT_NEAR(sim.energy.gravityWork, m * kG * (z0 - z), 1e-12 * m * kG * 5e-4) << "step " << i;
+    ASSERT_NEAR(sim.energy.gravityWork, m * kGravity * (z0 - z), 1e-12 * m * kGravity * 5e-4) << "step " << i;
     const double stored = lab::kineticEnergy(sim) + lab::elasticEnergy(sim);
     worst = std::max(worst, std::abs(stored - sim.energy.gravityWork));
     bounced = bounced || sim.particles.velocity[0].z() > 0.0;
   }
   ASSERT_TRUE(bounced) << "the sphere should have hit the floor and bounced";
-  EXPECT_LT(worst, 2e-2 * m * kG * 5e-4) << "slip " << sim.energy.slip << " rolling " << sim.energy.rolling
-                                         << " damping " << sim.energy.damping << " worst/mgh " << worst / (m * kG * 5e-4)
+  EXPECT_LT(worst, 2e-2 * m * kGravity * 5e-4) << "slip " << sim.energy.slip << " rolling " << sim.energy.rolling
+                                         << " damping " << sim.energy.damping << " worst/mgh " << worst / (m * kGravity * 5e-4)
                                          << " kinetic " << lab::kineticEnergy(sim) << " elastic " << lab::elasticEnergy(sim)
                                          << " W_g " << sim.energy.gravityWork << " z " << sim.particles.position[0].z();
 }

@@ -15,11 +15,11 @@ using namespace grainlab;
 
 namespace {
 
-constexpr double kR = 1e-3, kRho = 2600.0;
+constexpr double kLayerR = 1e-3, kLayerRho = 2600.0;
 
 Particles oneSphereAt(double z) {
   Particles p;
-  p.addSphere(Vec3(0.0, 0.0, z), kR, kRho);
+  p.addSphere(Vec3(0.0, 0.0, z), kLayerR, kLayerRho);
   return p;
 }
 
@@ -29,24 +29,24 @@ double sphereVolume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
 
 TEST(Layers, SolidVolumeBetweenPlanesByHand) {
   const Particles p = oneSphereAt(0.0);
-  EXPECT_NEAR(lab::solidVolumeBetween(p, -2 * kR, 2 * kR) / sphereVolume(kR), 1.0, 1e-12);
-  EXPECT_NEAR(lab::solidVolumeBetween(p, 0.0, 5 * kR) / sphereVolume(kR), 0.5, 1e-12);
-  EXPECT_NEAR(lab::solidVolumeBetween(p, -5 * kR, 0.0) / sphereVolume(kR), 0.5, 1e-12);
+  EXPECT_NEAR(lab::solidVolumeBetween(p, -2 * kLayerR, 2 * kLayerR) / sphereVolume(kLayerR), 1.0, 1e-12);
+  EXPECT_NEAR(lab::solidVolumeBetween(p, 0.0, 5 * kLayerR) / sphereVolume(kLayerR), 0.5, 1e-12);
+  EXPECT_NEAR(lab::solidVolumeBetween(p, -5 * kLayerR, 0.0) / sphereVolume(kLayerR), 0.5, 1e-12);
   // A cap of height r/2 at the top: 5/24 pi r^3.
-  EXPECT_NEAR(lab::solidVolumeBetween(p, 0.5 * kR, 3 * kR) / (5.0 / 24.0 * kPi * kR * kR * kR), 1.0, 1e-12);
-  EXPECT_EQ(lab::solidVolumeBetween(p, 2 * kR, 3 * kR), 0.0);
+  EXPECT_NEAR(lab::solidVolumeBetween(p, 0.5 * kLayerR, 3 * kLayerR) / (5.0 / 24.0 * kPi * kLayerR * kLayerR * kLayerR), 1.0, 1e-12);
+  EXPECT_EQ(lab::solidVolumeBetween(p, 2 * kLayerR, 3 * kLayerR), 0.0);
 }
 
 TEST(Layers, SlicesOfAStackAddUpToItsSolidVolume) {
   Particles p;
   double total = 0.0;
   for (int k = 0; k < 7; ++k) {
-    const double r = kR * (0.6 + 0.1 * k);
-    p.addSphere(Vec3(0.1 * k * kR, 0.0, 1.7 * kR * k), r, kRho);
+    const double r = kLayerR * (0.6 + 0.1 * k);
+    p.addSphere(Vec3(0.1 * k * kLayerR, 0.0, 1.7 * kLayerR * k), r, kLayerRho);
     total += sphereVolume(r);
   }
   double sum = 0.0;
-  for (int s = 0; s < 13; ++s) sum += lab::solidVolumeBetween(p, -kR + s * kR, s * kR);
+  for (int s = 0; s < 13; ++s) sum += lab::solidVolumeBetween(p, -kLayerR + s * kLayerR, s * kLayerR);
   EXPECT_NEAR(sum / total, 1.0, 1e-12);
 }
 
@@ -55,13 +55,13 @@ TEST(Layers, AppendSlabPlacesAboveTheBedWithoutOverlaps) {
   lab::Rng rng(11);
   const double width = 0.005, voidRatio = 2.0;  // both slabs above the 2 d minimum height
   std::vector<double> first(40, 1.2e-3), second(80, 1.0e-3);
-  const double h1 = lab::appendSlab(first, kRho, voidRatio, width, 0.0, rng, sim);
+  const double h1 = lab::appendSlab(first, kLayerRho, voidRatio, width, 0.0, rng, sim);
   ASSERT_EQ(sim.particles.size(), 40u);
   double top = 0.0;
   for (std::size_t i = 0; i < sim.particles.size(); ++i)
     top = std::max(top, sim.particles.position[i].z() + sim.particles.radius[i]);
   EXPECT_LE(top, h1 + 1e-12);
-  const double h2 = lab::appendSlab(second, kRho, voidRatio, width, top, rng, sim);
+  const double h2 = lab::appendSlab(second, kLayerRho, voidRatio, width, top, rng, sim);
   const Particles& P = sim.particles;
   ASSERT_EQ(P.size(), 120u);
   double solid = 0.0;
