@@ -202,7 +202,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
         "rolling_friction", "sphericity", "shear_modulus", "rolling", "restitution"}},
       {"test",
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
-        "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "servo_max_speed",
+        "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "rate_follows_pressure", "servo_max_speed",
         "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
         "n_cycles", "ru_limit", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude", "aspect_ratio", "membrane_young",
         "membrane_thickness", "membrane_bin_d50", "platen_friction_deg"}},
@@ -593,7 +593,8 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
     return "only used with test.type = \"cyclic-triaxial\" or an undrained test (test.drainage = \"undrained\")";
   if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
     return "only used with test.unload_reload_at (unload-reload loops)";
-  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed") && !shear)
+  if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed" || key == "test.rate_follows_pressure") &&
+      !shear)
     return "not used with test.type = \"isotropic\" (no shearing)";
   if (key == "solver.force_dt" && !c.solver.dt) return "only used with solver.dt (it allows a dt above the critical step)";
   if (key == "solver.damping" && c.solver.viscousDamping > 0.0)
@@ -630,7 +631,8 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
       // rate when it is run as an isotropic or simple-shear test): the other test's keys warn.
       static const std::set<std::string> testTypeKeys{
           "test.b", "test.axial_strain_rate", "test.final_axial_strain", "test.shear_strain_rate",
-          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.servo_max_speed", "test.cs_window",
+          "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.rate_follows_pressure", "test.servo_max_speed",
+          "test.cs_window",
           "test.drainage", "test.max_axial_stress", "test.unload_axial_stress", "test.csr", "test.n_cycles",
           "test.ru_limit", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
           "test.cycles_per_amplitude"};
@@ -1062,6 +1064,7 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                "must be in [0, 1) (unbalanced-force ratio above which the platens slow down; 0: off)");
   c.test.servoMaxSpeed = t.number("servo_max_speed", c.test.servoMaxSpeed, 0.0, 1e3, true, false,
                                   "must be in (0, 1000] [m/s] (servo speed cap while the test runs)");
+  c.test.rateFollowsPressure = t.boolean("rate_follows_pressure", c.test.rateFollowsPressure);
   c.test.loopRest = t.boolean("loop_rest", c.test.loopRest);
   c.test.unloadToQFraction = t.number("unload_to_q_fraction", c.test.unloadToQFraction, 0.0, 1.0, false, true,
                                       "must be in [0, 1) (an unload ends at this fraction of the deviator at reversal)");
@@ -1271,6 +1274,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(test, "test", "unload_to_q_fraction", c.test.unloadToQFraction);
   put(test, "test", "loop_rest", c.test.loopRest);
   put(test, "test", "platen_slowdown_unbalanced", c.test.platenSlowdownUnbalanced);
+  put(test, "test", "rate_follows_pressure", c.test.rateFollowsPressure);
   put(test, "test", "servo_max_speed", c.test.servoMaxSpeed);
   if (c.test.csWindow) put(test, "test", "cs_window", *c.test.csWindow);
   else put(test, "test", "cs_window", "auto");

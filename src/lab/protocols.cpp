@@ -356,6 +356,10 @@ void Laboratory::loadState(std::istream& in) {
     protocol_.reset();
   }
   if (!(st.slowdown > 0.0 && st.slowdown <= 1.0)) throw std::runtime_error("inconsistent state: platen slow-down factor");
+  if (!(st.pressureFactor >= kMinPressureRateFactor && st.pressureFactor <= 1.0) ||
+      !(st.result.rateFactorMin >= kMinPressureRateFactor && st.result.rateFactorMin <= st.pressureFactor) ||
+      (!config_.test.rateFollowsPressure && st.pressureFactor != 1.0))
+    throw std::runtime_error("inconsistent state: loading-rate factor of test.rate_follows_pressure");
   if (st.loopNext < 0 || st.loopNext > static_cast<int>(config_.test.unloadReloadAt.size()) || st.loopPhase < 0 ||
       st.loopPhase > 3 || (st.loopPhase == 3 && !config_.test.loopRest) || (st.loopPhase != 0 && st.loopNext == static_cast<int>(config_.test.unloadReloadAt.size())))
     throw std::runtime_error("inconsistent state: unload-reload loop state does not match test.unload_reload_at");

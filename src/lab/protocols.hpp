@@ -166,10 +166,13 @@ struct ShearResult {
   double maxLateralDeviation = 0.0;     // max |sigma_lat - target|/p, lateral stress = mean of two walls
   double maxSingleWallDeviation = 0.0;  // the same for the worst single lateral wall (wall box)
   long steps = 0;
+  // test.rate_follows_pressure: the smallest factor the loading rate was slowed to (1: never).
+  double rateFactorMin = 1.0;
   // Every field, in the order a checkpoint holds them (stateio::Listed).
   template <class Self>
   static auto fields(Self& s) {
-    return std::tie(s.records, s.strainRate, s.inertialNumber, s.maxLateralDeviation, s.maxSingleWallDeviation, s.steps);
+    return std::tie(s.records, s.strainRate, s.inertialNumber, s.maxLateralDeviation, s.maxSingleWallDeviation, s.steps,
+                    s.rateFactorMin);
   }
 };
 
@@ -261,6 +264,13 @@ class Laboratory {
   // never falls below kMinPlatenSlowdown of the loading speed.
   static constexpr long kSlowdownCheckSteps = 10;
   static constexpr double kMinPlatenSlowdown = 0.05;
+  // test.rate_follows_pressure: the rate follows sqrt(p'/(kPressureRateHeadroom p0)), checked every
+  // kSlowdownCheckSteps steps, at most 1 and never below kMinPressureRateFactor of the rate at p0 (I
+  // stays under its p0 value down to p' = kMinPressureRateFactor^2 p0 = 4e-4 p0). The headroom
+  // covers the stress's fluctuation between a check and the records' mean (measured: up to 6 %
+  // in a liquefying 300-grain cell), which would otherwise carry I a little above its p0 value.
+  static constexpr double kMinPressureRateFactor = 0.02;
+  static constexpr double kPressureRateHeadroom = 1.1;
   // A record of the current state; the boundary stresses are meanStress when given (the mean over
   // the recording interval, as a load cell reports it), else the instantaneous ones.
   Record measure(const Vec3* meanStress = nullptr, double meanShearStress = 0.0) const;
@@ -299,6 +309,7 @@ class Laboratory {
     long loopRestStart = -1;   // the step a rest before an unload began (test.loop_rest)
     bool forceRecord = false;  // a record at a loop's reversal, turning point or end (same step)
     double slowdown = 1.0;     // platen speed factor from the unbalanced force (test.platen_slowdown_unbalanced)
+    double pressureFactor = 1.0;  // loading-rate factor sqrt(p'/p0) (test.rate_follows_pressure)
     // The shear band's strain windows (output.band_strain_window): the driving strain at the start
     // of the current window, the box lengths there and at the previous one's (their grains in
     // window_, previousWindow_), the windows closed, and the band of the last one.
@@ -314,7 +325,7 @@ class Laboratory {
       return std::tie(s.started, s.h0, s.v0, s.l0, s.rampSteps, s.startStep, s.nextRecord, s.nextSnapshot,
                       s.nextCheckpoint, s.stressSum, s.shearStressSum, s.wallStressSum, s.stressSamples, s.elastic0,
                       s.kinetic0, s.result, s.loopNext, s.loopPhase, s.loopQ, s.loopEndStep, s.loopRestStart,
-                      s.forceRecord, s.slowdown, s.windowStrain, s.windowLengths,
+                      s.forceRecord, s.slowdown, s.pressureFactor, s.windowStrain, s.windowLengths,
                       s.previousWindowLengths, s.bandWindows, s.bandFound, s.band);
     }
   };

@@ -188,6 +188,10 @@ struct TestConfig {
   // Platens slow down while the unbalanced-force ratio exceeds this (speed x threshold/ratio, at
   // least kMinPlatenSlowdown), so that the lateral servos can follow a collapse; 0: off.
   double platenSlowdownUnbalanced = 0.0;
+  // The loading rate follows the mean effective stress, rate(p') = rate(p0) sqrt(p'/p0) (never
+  // above it, never below Laboratory::kMinPressureRateFactor of it), so that the inertial number
+  // stays at its value at p0 when p' falls (undrained flow of a loose sample).
+  bool rateFollowsPressure = false;
   // Speed cap of the boundary servos while the test runs [m/s] (cell: 2 x this / cell length as a
   // rate). By default above solver.servoMaxSpeed, which governs the preparation (walls that approach a loose
   // cloud without contacts move at the cap there): in a test the lateral walls only reach the cap

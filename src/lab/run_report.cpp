@@ -314,6 +314,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
   if (lab.protocol()->undrained()) undrainedKeys(config, records, lab.protocol()->state.volumeDriftMax, s);
   s["strain_rate"] = shear.strainRate;
   s["inertial_number"] = shear.inertialNumber;
+  if (config.test.rateFollowsPressure) s["rate_factor_min"] = shear.rateFactorMin;
   // Simple shear has no lateral stress target: not measured.
   s["lateral_stress_max_deviation"] = simpleShear ? Json(nullptr) : Json(shear.maxLateralDeviation);
   if (config.test.boundary == "walls") s["lateral_stress_max_deviation_single_wall"] = shear.maxSingleWallDeviation;
@@ -453,6 +454,7 @@ void reportReversing(const RunConfig& config, const ShearResult& shear, Laborato
   }
   s["strain_rate"] = shear.strainRate;
   s["inertial_number"] = shear.inertialNumber;
+  if (config.test.rateFollowsPressure) s["rate_factor_min"] = shear.rateFactorMin;
   s["shear_pipeline"] = lab.shearStageNames();
   s["final_axial_strain"] = records.back().eps1;
   s["shear_steps"] = shear.steps;

@@ -45,8 +45,9 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   }
   r.coordination = coordinationNumber(sim_);
   r.unbalanced = unbalancedForceRatio(sim_);
-  r.inertialNumber =
-      shear_.result.strainRate * d50_ * std::sqrt(config_.sample.density / std::max(r.p, 1e-300));
+  // The rate in force (test.rate_follows_pressure slows it; the factor is 1 otherwise).
+  r.inertialNumber = shear_.result.strainRate * shear_.pressureFactor * d50_ *
+                     std::sqrt(config_.sample.density / std::max(r.p, 1e-300));
   const Mat3 sc = contactStress(sim_);
   r.sigma1Contact = sc(2, 2);
   r.sigma2Contact = sc(0, 0);
@@ -101,15 +102,17 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
 
 double Laboratory::loadingFactor() const {
   const ShearState& st = shear_;
+  // Both slow-downs act together: the unbalanced force's and the mean stress's (1 when off).
+  const double slow = st.slowdown * st.pressureFactor;
   if (st.loopPhase == 3) return 0.0;
-  if (st.loopPhase == 1) return -kLoopSpeedFactor * st.slowdown;
-  if (st.loopPhase == 2) return kLoopSpeedFactor * st.slowdown;
+  if (st.loopPhase == 1) return -kLoopSpeedFactor * slow;
+  if (st.loopPhase == 2) return kLoopSpeedFactor * slow;
   const double ramp = std::min(1.0, static_cast<double>(sim_.stepCount - st.startStep + 1) / st.rampSteps);
-  if (st.loopEndStep < 0) return ramp * st.slowdown;
+  if (st.loopEndStep < 0) return ramp * slow;
   // After a loop the platens speed up again from the loop's speed over the same ramp.
-  return st.slowdown * std::min(ramp, kLoopSpeedFactor + (1.0 - kLoopSpeedFactor) *
-                                                             static_cast<double>(sim_.stepCount - st.loopEndStep) /
-                                                             st.rampSteps);
+  return slow * std::min(ramp, kLoopSpeedFactor + (1.0 - kLoopSpeedFactor) *
+                                                      static_cast<double>(sim_.stepCount - st.loopEndStep) /
+                                                      st.rampSteps);
 }
 
 void Laboratory::beginShear() {
@@ -197,6 +200,14 @@ void Laboratory::buildShearPipeline(Pipeline& pipeline) {
       const double threshold = config_.test.platenSlowdownUnbalanced;
       const double unbalanced = unbalancedForceRatio(sim_);
       st.slowdown = unbalanced > threshold ? std::max(kMinPlatenSlowdown, threshold / unbalanced) : 1.0;
+    }, Pipeline::Trigger::onlyIf([this] { return sim_.stepCount % kSlowdownCheckSteps == 0; }));  // resumes in phase
+  if (t.rateFollowsPressure)
+    pipeline.addAfter("rate follows p'", [this, &st, p] {
+      // The inertial number I = rate d50 sqrt(rho/p') held at its value at p0 while p' < p0.
+      const Vec3 s = boundaryStress(sim_);
+      const double pNow = std::max(0.0, (s[0] + s[1] + s[2]) / 3.0);
+      st.pressureFactor = std::clamp(std::sqrt(pNow / (kPressureRateHeadroom * p)), kMinPressureRateFactor, 1.0);
+      st.result.rateFactorMin = std::min(st.result.rateFactorMin, st.pressureFactor);
     }, Pipeline::Trigger::onlyIf([this] { return sim_.stepCount % kSlowdownCheckSteps == 0; }));  // resumes in phase
   if (!t.unloadReloadAt.empty())
     pipeline.addAfter("unload-reload", [this, &st, strain = axial] {

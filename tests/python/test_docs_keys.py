@@ -227,6 +227,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "deposition",                          # sample.method = "deposition"
     "under_compaction",                    # sample.method = "under-compaction"
     "membrane",                            # test.boundary = "membrane"
+    "rate_factor_min",                     # test.rate_follows_pressure = true
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
     # undrained tests

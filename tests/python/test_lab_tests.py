@@ -8,6 +8,7 @@ import json
 import math
 import os
 import subprocess
+import tomllib
 
 import numpy as np
 import pytest
@@ -53,6 +54,50 @@ def test_undrained_triaxial_holds_the_volume_and_reports_u(tmp_path, boundary, a
     assert c["eps1"][-1] == pytest.approx(0.02, abs=1e-3)
     assert c["eps2"][-1] < 0 and c["eps3"][-1] < 0
     assert isinstance(s["liquefied"], bool)
+
+
+def local_rates(c, ramp_steps):
+    """(dε1/dt between consecutive records, mean p of the interval) after the loading ramp."""
+    t, e1, p, step = c["time"], c["eps1"], c["p"], c["step"]
+    keep = step[:-1] - step[0] > ramp_steps
+    return (np.diff(e1) / np.diff(t))[keep], p[1:][keep]
+
+
+@pytest.mark.parametrize("follows", [False, True])
+def test_rate_follows_pressure_holds_the_inertial_number_as_p_falls(tmp_path, follows):
+    """A loose sample sheared undrained loses p' (u rises): with test.rate_follows_pressure the
+    platens' strain rate between records is the rate at p0 times sqrt(p'/(1.1 p0)) (clamped to
+    [0.02, 1]), recomputed here from the time series, so I stays under its p0 value; without the key
+    the rate stays the one at p0 and I exceeds 1e-3. The same check on the run without the key fails
+    (the first parameter): the rate law is what the records show, not what the summary says."""
+    proc = subprocess.run([GRAINLAB, "run", "preset:csl-loose", "--out", str(tmp_path / "r"), "--quiet", "--threads", "1",
+                           "--set", "sample.n_particles=300", "--set", "test.final_axial_strain=0.03",
+                           "--set", "test.probe_strain=0", "--set", 'test.drainage="undrained"',
+                           "--set", f"test.rate_follows_pressure={'true' if follows else 'false'}",
+                           "--set", "output.plots=false", "--set", "output.vtk_every_strain=0"],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    c, s = read(tmp_path / "r")
+    p0, rate = s["confining_pressure"], s["strain_rate"]
+    assert c["p"].min() < 0.5 * p0  # the loose sample contracts: p' falls well below p0
+    # The loading ramp: 40 servo integral times (docs/laboratory.md §2).
+    with open(tmp_path / "r" / "config.resolved.toml", "rb") as f:
+        ramp_steps = 40 * tomllib.load(f)["solver"]["servo_integral_steps"]
+    r, p = local_rates(c, ramp_steps)
+    expected = rate * np.clip(np.sqrt(p / (1.1 * p0)), 0.02, 1.0)
+    slowed = p < 0.8 * p0
+    assert slowed.sum() >= 5
+    matches = np.abs(r[slowed] / expected[slowed] - 1) < 0.1
+    if follows:
+        assert matches.mean() > 0.9, (r[slowed] / expected[slowed])
+        assert s["rate_factor_min"] == pytest.approx(np.sqrt(c["p"].min() / (1.1 * p0)), rel=0.15)
+        assert s["inertial_number_max"] <= 1e-3 and s["quasi_static"] is True
+        # The records' I is the one of the slowed rate: I = rate factor d50 sqrt(rho/p).
+        assert c["inertial_number"].max() <= 1e-3
+    else:
+        assert matches.mean() < 0.5
+        assert np.allclose(r, rate, rtol=0.02)
+        assert "rate_factor_min" not in s and s["inertial_number_max"] > 1e-3
 
 
 def test_oedometer_keeps_lateral_strain_zero_and_reports_k0(tmp_path):
@@ -127,6 +172,7 @@ def test_kill_and_resume_is_bit_identical(tmp_path, test):
     (['test.type="cyclic-triaxial"', "test.ru_limit=1.5"], "test.ru_limit", ["(0, 1]"]),
     (['test.type="cyclic-triaxial"', "test.liquefaction_da_strain=0.9"], "test.liquefaction_da_strain", ["(0, 0.5]"]),
     (['test.type="stress-path"'], "test.path", ['needs its table']),
+    (['test.rate_follows_pressure="yes"'], "test.rate_follows_pressure", ["true", "false"]),
 ])
 def test_bad_input_of_the_new_tests_is_refused(tmp_path, extra, key, words):
     proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets(*extra)], capture_output=True, text=True, timeout=60)
@@ -141,6 +187,7 @@ def test_bad_input_of_the_new_tests_is_refused(tmp_path, extra, key, words):
     (['test.type="oedometer"', 'test.drainage="undrained"'], "test.drainage"),
     (["test.csr=0.2"], "test.csr"),
     (['test.type="cyclic-triaxial"', "test.max_axial_stress=2e6"], "test.max_axial_stress"),
+    (['test.type="isotropic"', "test.rate_follows_pressure=true"], "test.rate_follows_pressure"),
 ])
 def test_keys_of_another_test_warn(extra, key):
     """As for the other tests' keys (a config reused with --set test.type=...): ignored, with a

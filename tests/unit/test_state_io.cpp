@@ -49,6 +49,7 @@ struct ShearStateMembers {
   long loopRestStart;
   bool forceRecord;
   double slowdown;
+  double pressureFactor;
   double windowStrain;
   Vec3 windowLengths, previousWindowLengths;
   long bandWindows;
