@@ -1180,6 +1180,13 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
     if (c.sample.gravity)
       fail("sample.gravity", fmt::format("[{}, {}, {}]", (*c.sample.gravity)[0], (*c.sample.gravity)[1], (*c.sample.gravity)[2]),
            "not with test.boundary = \"membrane\" (no hydrostatic cell pressure); allowed: no gravity");
+    // Frictionless spheres under a flexible membrane never come to rest: the bins' small pressure
+    // differences keep them flowing (the reason preparation uses a rigid cylinder), so a test would
+    // end in solver.max_steps instead of an equilibrium.
+    if (c.contact.frictionDeg <= 0.0)
+      fail("contact.friction_deg", fmt::format("{:g}", c.contact.frictionDeg),
+           "must be > 0 with test.boundary = \"membrane\" (frictionless spheres flow under a flexible membrane and "
+           "never reach equilibrium); allowed: (0, 90) [deg], or test.boundary = \"walls\"");
   }
   refuseInapplicable(root, c);
   return c;

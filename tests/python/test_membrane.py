@@ -127,6 +127,7 @@ BAD = [
     (['sample.method="lattice"'], "sample.method", "lattice"),
     (['sample.shape={ type = "ellipsoid", elongation = 0.8 }'], "sample.shape.type", "ellipsoid"),
     (["sample.gravity=[0.0, 0.0, -9.81]"], "sample.gravity", "-9.81"),
+    (["contact.friction_deg=0"], "contact.friction_deg", "0"),
     (['test.boundary="walls"', "test.aspect_ratio=2"], "test.aspect_ratio", "membrane"),
 ]
 
