@@ -5,7 +5,7 @@ loose and a dense sample, the oedometer, cyclic triaxial at several CSRs, cyclic
 (docs/results/lab-tests.md).
 
     /usr/bin/python3 tools/lab_tests_study.py run    [--runs runs/lab-tests] [--exe build/grainlab] [--jobs 2]
-                                                     [--seeds 1,2,3] [--only cu,oedometer,cyclic,css]
+                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css]
     /usr/bin/python3 tools/lab_tests_study.py report [--runs runs/lab-tests] [--seeds 1,2,3]
                                                      [--out docs/results/lab-tests.md]
 
@@ -36,6 +36,9 @@ OEDOMETER = ['test.type="oedometer"', "test.max_axial_stress=2e6", "test.unload_
              "test.axial_strain_rate=0.1", "output.vtk_every_strain=0"]
 CYCLIC = ['test.type="cyclic-triaxial"', 'test.drainage="undrained"', "test.n_cycles=15",
           "test.axial_strain_rate=0.1", "output.vtk_every_strain=0"]
+# The loose undrained test again with the loading rate following p' (test.rate_follows_pressure),
+# beside the same samples at the fixed rate: is the flow's minimum p' a rate effect?
+CU_SLOW = CU + ["test.rate_follows_pressure=true"]
 CSRS = (0.15, 0.25)
 CSS = ['test.type="cyclic-simple-shear"', "test.shear_strain_amplitudes=[1e-5, 1e-4, 1e-3, 1e-2]",
        "test.cycles_per_amplitude=2", "output.vtk_every_strain=0"]
@@ -47,6 +50,10 @@ def cases(seeds, only):
         if "cu" in only:
             yield "cu", "csl-loose", f"cu-loose_s{seed}", CU + s
             yield "cu", "csl-dense", f"cu-dense_s{seed}", CU + s
+        if "cu-slow" in only:
+            if "cu" not in only:
+                yield "cu-slow", "csl-loose", f"cu-loose_s{seed}", CU + s
+            yield "cu-slow", "csl-loose", f"cu-loose-slow_s{seed}", CU_SLOW + s
         if "oedometer" in only:
             yield "oedometer", "csl-dense", f"oed-dense_s{seed}", OEDOMETER + s
         if "cyclic" in only and seed <= 2:
@@ -133,6 +140,45 @@ def report(a):
         fig.savefig(os.path.join(out_dir, "undrained.png"), dpi=110)
         plt.close(fig)
         write_table(os.path.join(out_dir, "undrained-table.md"), lines)
+    # Undrained loose: fixed rate against the rate that follows p'.
+    if "cu-slow" in a.only:
+        lines = ["| rate | seed | e0 | p′ min [kPa] | ε1 at p′ min [%] | liquefied | I max | rate factor min | "
+                 "q at 5 % [kPa] | p′ end [kPa] | q end [kPa] | volume drift max | wall [s] |",
+                 "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+        fig, (ax, axp) = plt.subplots(1, 2, figsize=(11, 4.2))
+        for seed in a.seeds:
+            for name, label, style in ((f"cu-loose_s{seed}", "fixed (from p0)", "-"),
+                                       (f"cu-loose-slow_s{seed}", "follows p′", "--")):
+                if name not in done:
+                    continue
+                g, preset, s, d = done[name]
+                eps, p, q = d["eps1"], d["p"], d["q"]
+                k = min(range(len(p)), key=lambda i: p[i])
+                q5 = next((q[i] for i in range(len(eps)) if eps[i] >= 0.05), None)
+                lines.append(f"| {label} | {seed} | {s['e0']:.3f} | {s['p_min'] / 1e3:.1f} | {100 * eps[k]:.2f} | "
+                             f"{fmt(s['liquefied'])} | {s['inertial_number_max']:.2g} | {fmt(s.get('rate_factor_min'))} | "
+                             f"{fmt(q5 / 1e3 if q5 is not None else None)} | {p[-1] / 1e3:.0f} | {q[-1] / 1e3:.0f} | "
+                             f"{s['volume_drift_max']:.1e} | {s['wall_seconds']:.0f} |")
+                colour = f"C{seed - 1}"
+                ax.plot([x / 1e3 for x in p], [x / 1e3 for x in q], style, color=colour, lw=0.9,
+                        label=f"seed {seed}, {label}")
+                axp.plot([100 * e for e in eps], [x / 1e3 for x in p], style, color=colour, lw=0.9)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("p′ [kPa] (log)")
+        ax.set_ylabel("q [kPa] (log)")
+        ax.legend(fontsize=7)
+        axp.set_xlabel("axial strain ε1 [%]")
+        axp.set_ylabel("p′ [kPa] (log)")
+        axp.set_yscale("log")
+        for x in (ax, axp):
+            x.grid(alpha=0.3, which="both")
+        fig.suptitle("Undrained triaxial, loose calibrated Karlsruhe sand, p0 = 200 kPa: fixed rate (solid) "
+                     "and rate following p′ (dashed)", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "undrained-rate.png"), dpi=110)
+        plt.close(fig)
+        write_table(os.path.join(out_dir, "undrained-rate-table.md"), lines)
     # Oedometer.
     if "oedometer" in a.only:
         lines = ["| seed | e0 | K0 | K0 unloading | Cc | Cs | σv max [kPa] | wall [s] |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -217,7 +263,7 @@ def report(a):
                          f"{mean_sd([100 * x[2] for x in v])} |")
         write_table(os.path.join(out_dir, "css-table.md"), lines)
     # A group none of whose cases completed has no table or plot (not an empty one).
-    files = {"cu": ("undrained-table.md", "undrained.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
+    files = {"cu": ("undrained-table.md", "undrained.png"), "cu-slow": ("undrained-rate-table.md", "undrained-rate.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
              "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png")}
     # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
@@ -237,7 +283,7 @@ def main():
     ap.add_argument("--exe", default="build/grainlab")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seeds", default="1,2,3")
-    ap.add_argument("--only", default="cu,oedometer,cyclic,css")
+    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css")
     ap.add_argument("--out", default="docs/results/lab-tests.md")
     a = ap.parse_args()
     a.seeds = [int(s) for s in a.seeds.split(",")]
