@@ -5,7 +5,7 @@ loose and a dense sample, the oedometer, cyclic triaxial at several CSRs, cyclic
 (docs/results/lab-tests.md).
 
     /usr/bin/python3 tools/lab_tests_study.py run    [--runs runs/lab-tests] [--exe build/grainlab] [--jobs 2]
-                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css]
+                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css,ucss,cav]
     /usr/bin/python3 tools/lab_tests_study.py report [--runs runs/lab-tests] [--seeds 1,2,3]
                                                      [--out docs/results/lab-tests.md]
 
@@ -40,6 +40,9 @@ CYCLIC = ['test.type="cyclic-triaxial"', 'test.drainage="undrained"', "test.n_cy
 # beside the same samples at the fixed rate: is the flow's minimum p' a rate effect?
 CU_SLOW = CU + ["test.rate_follows_pressure=true"]
 CSRS = (0.15, 0.25)
+# The dense undrained test again with cavitation of the pore water (test.back_pressure 300 kPa: it
+# cavitates at u = -399 kPa), beside the ideal constraint of "cu" (u falls to about -14 p0).
+CAV = CU + ["test.back_pressure=300e3"]
 CSS = ['test.type="cyclic-simple-shear"', "test.shear_strain_amplitudes=[1e-5, 1e-4, 1e-3, 1e-2]",
        "test.cycles_per_amplitude=2", "output.vtk_every_strain=0"]
 
@@ -61,6 +64,10 @@ def cases(seeds, only):
                 yield "cyclic", "csl-loose", f"cyc-loose_csr{csr:g}_s{seed}", CYCLIC + [f"test.csr={csr}"] + s
         if "css" in only:
             yield "css", "csl-dense", f"css-dense_s{seed}", CSS + s
+        if "cav" in only:
+            yield "cav", "csl-dense", f"cu-dense-bp300_s{seed}", CAV + s
+        if "ucss" in only:
+            yield "ucss", "csl-dense", f"ucss-dense_s{seed}", CSS + ['test.drainage="undrained"'] + s
 
 
 def run(a):
@@ -93,6 +100,45 @@ def mean_sd(values):
     if len(v) == 1:
         return f"{v[0]:.3g} (1 seed)"
     return f"{statistics.mean(v):.3g} ± {statistics.stdev(v):.2g} ({len(v)} seeds)"
+
+
+def css_report(done, group, title, png, table):
+    """The G/Gmax and damping table and plot of one cyclic simple shear group."""
+    per_amp = {}
+    lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | wall [s] |",
+             "|---:|---:|---:|---:|---|---|---:|"]
+    fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for name, (g, preset, s, d) in sorted(done.items()):
+        if g != group:
+            continue
+        amps, ratio, xi = s["shear_strain_amplitudes"], s["G_over_Gmax"], s["damping_ratio"]
+        for k, (am, r, x) in enumerate(zip(amps, ratio, xi)):
+            per_amp.setdefault(k, []).append((am, r, x))
+        gp = s["E0_MPa"] / (2 * (1 + s["nu0"])) if s.get("E0_MPa") and s.get("nu0") is not None else None
+        lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
+                     + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
+                     + ", ".join(f"{100 * x:.2f}" for x in xi) + f" | {s['wall_seconds']:.0f} |")
+        axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
+        axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
+    axg.set_xlabel("shear strain amplitude γa")
+    axg.set_ylabel("G / Gmax")
+    axd.set_xlabel("shear strain amplitude γa")
+    axd.set_ylabel("damping ratio ξ [%]")
+    for x in (axg, axd):
+        x.grid(alpha=0.3, which="both")
+        x.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    lines.append("")
+    lines.append("| γa | G/Gmax | ξ [%] |")
+    lines.append("|---:|---|---|")
+    for k in sorted(per_amp):
+        v = per_amp[k]
+        lines.append(f"| {statistics.mean(x[0] for x in v):.1e} | {mean_sd([x[1] for x in v])} | "
+                     f"{mean_sd([100 * x[2] for x in v])} |")
+    write_table(table, lines)
 
 
 def report(a):
@@ -224,47 +270,29 @@ def report(a):
         plt.tight_layout()
         plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
         plt.close()
-        write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
-    # Cyclic simple shear.
-    if "css" in a.only:
-        per_amp = {}
-        lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | wall [s] |",
-                 "|---:|---:|---:|---:|---|---|---:|"]
-        fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
+        # Per CSR over the seeds: N of each seed (a run that did not liquefy counts as "> cycles run").
+        lines += ["", "| CSR | seeds | liquefied | N per seed | N median |", "|---:|---:|---:|---|---:|"]
+        by_csr = {}
         for name, (g, preset, s, d) in sorted(done.items()):
-            if g != "css":
-                continue
-            amps, ratio, xi = s["shear_strain_amplitudes"], s["G_over_Gmax"], s["damping_ratio"]
-            for k, (am, r, x) in enumerate(zip(amps, ratio, xi)):
-                per_amp.setdefault(k, []).append((am, r, x))
-            gp = s["E0_MPa"] / (2 * (1 + s["nu0"])) if s.get("E0_MPa") and s.get("nu0") is not None else None
-            lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
-                         + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
-                         + ", ".join(f"{100 * x:.2f}" for x in xi) + f" | {s['wall_seconds']:.0f} |")
-            axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
-            axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
-        axg.set_xlabel("shear strain amplitude γa")
-        axg.set_ylabel("G / Gmax")
-        axd.set_xlabel("shear strain amplitude γa")
-        axd.set_ylabel("damping ratio ξ [%]")
-        for x in (axg, axd):
-            x.grid(alpha=0.3, which="both")
-            x.legend(fontsize=8)
-        fig.suptitle("Drained cyclic simple shear, dense, σzz = 200 kPa", fontsize=10)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out_dir, "css.png"), dpi=110)
-        plt.close(fig)
-        lines.append("")
-        lines.append("| γa | G/Gmax | ξ [%] |")
-        lines.append("|---:|---|---|")
-        for k in sorted(per_amp):
-            v = per_amp[k]
-            lines.append(f"| {statistics.mean(x[0] for x in v):.1e} | {mean_sd([x[1] for x in v])} | "
-                         f"{mean_sd([100 * x[2] for x in v])} |")
-        write_table(os.path.join(out_dir, "css-table.md"), lines)
+            if g == "cyclic":
+                by_csr.setdefault(s["csr"], []).append(s)
+        for csr in sorted(by_csr):
+            v = sorted(by_csr[csr], key=lambda s: s["seed"])
+            ns = [s["n_cycles_to_liquefaction"] for s in v]
+            shown = [fmt(n) if n is not None else f"> {s['cycles']:g}" for n, s in zip(ns, v)]
+            median = statistics.median(ns) if all(n is not None for n in ns) else None
+            lines.append(f"| {csr:g} | {len(v)} | {sum(n is not None for n in ns)} | {', '.join(shown)} | {fmt(median)} |")
+        write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
+    # Cyclic simple shear, drained and undrained.
+    for group, title, png, table in (("css", "Drained cyclic simple shear, dense, σzz = 200 kPa", "css.png", "css-table.md"),
+                                     ("ucss", "Undrained (constant-volume) cyclic simple shear, dense, p0 = 200 kPa",
+                                      "ucss.png", "ucss-table.md")):
+        if group in a.only:
+            css_report(done, group, title, os.path.join(out_dir, png), os.path.join(out_dir, table))
     # A group none of whose cases completed has no table or plot (not an empty one).
     files = {"cu": ("undrained-table.md", "undrained.png"), "cu-slow": ("undrained-rate-table.md", "undrained-rate.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
-             "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png")}
+             "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png"),
+             "ucss": ("ucss-table.md", "ucss.png")}
     # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
     for g, names in files.items():
@@ -283,7 +311,7 @@ def main():
     ap.add_argument("--exe", default="build/grainlab")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seeds", default="1,2,3")
-    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css")
+    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css,ucss,cav")
     ap.add_argument("--out", default="docs/results/lab-tests.md")
     a = ap.parse_args()
     a.seeds = [int(s) for s in a.seeds.split(",")]

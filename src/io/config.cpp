@@ -204,7 +204,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& knownKeys()
        {"type", "boundary", "confining_pressure", "axial_strain_rate", "final_axial_strain", "b", "shear_strain_rate",
         "final_shear_strain", "probe_strain", "unload_reload_at", "platen_slowdown_unbalanced", "rate_follows_pressure", "servo_max_speed",
         "loop_rest", "unload_to_q_fraction", "cs_window", "drainage", "max_axial_stress", "unload_axial_stress", "csr",
-        "n_cycles", "ru_limit", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude", "aspect_ratio", "membrane_young",
+        "n_cycles", "ru_limit", "back_pressure", "liquefaction_da_strain", "path", "shear_strain_amplitudes", "cycles_per_amplitude", "aspect_ratio", "membrane_young",
         "membrane_thickness", "membrane_bin_d50", "platen_friction_deg"}},
       {"solver",
        {"damping", "viscous_damping", "dt_factor", "dt", "force_dt", "threads", "unbalanced_tolerance",
@@ -591,6 +591,9 @@ std::string inapplicable(const lab::RunConfig& c, const std::string& key) {
   if (key == "test.ru_limit" && tt != lab::TestType::CyclicTriaxial &&
       !(lab::info(tt).drainage && c.test.drainage == lab::Drainage::Undrained))
     return "only used with test.type = \"cyclic-triaxial\" or an undrained test (test.drainage = \"undrained\")";
+  if (key == "test.back_pressure" && !(lab::info(tt).drainage && c.test.drainage == lab::Drainage::Undrained))
+    return "only used with an undrained test (test.drainage = \"undrained\": the pore water's back pressure sets "
+           "where it cavitates)";
   if ((key == "test.unload_to_q_fraction" || key == "test.loop_rest") && c.test.unloadReloadAt.empty())
     return "only used with test.unload_reload_at (unload-reload loops)";
   if ((key == "test.platen_slowdown_unbalanced" || key == "test.servo_max_speed" || key == "test.rate_follows_pressure") &&
@@ -634,7 +637,7 @@ void refuseInapplicable(const toml::table& root, lab::RunConfig& c) {
           "test.final_shear_strain", "test.platen_slowdown_unbalanced", "test.rate_follows_pressure", "test.servo_max_speed",
           "test.cs_window",
           "test.drainage", "test.max_axial_stress", "test.unload_axial_stress", "test.csr", "test.n_cycles",
-          "test.ru_limit", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
+          "test.ru_limit", "test.back_pressure", "test.liquefaction_da_strain", "test.path", "test.shear_strain_amplitudes",
           "test.cycles_per_amplitude"};
       const bool otherTestsKey = testTypeKeys.count(key) > 0;
       // And a linear-law config run with Hertz–Mindlin (--set contact.model="hertz-mindlin" on a
@@ -1083,6 +1086,10 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
   c.test.nCycles = t.integer("n_cycles", c.test.nCycles, 1, 100'000);
   c.test.ruLimit = t.number("ru_limit", c.test.ruLimit, 0.0, 1.0, true, false,
                             "must be in (0, 1] (excess pore-pressure ratio ru = 1 - p'/p0 at liquefaction)");
+  if (t.raw("back_pressure"))
+    c.test.backPressure = t.number("back_pressure", 0.0, 0.0, 1e9, false, false,
+                                   "must be in [0, 1e9] [Pa] (the pore water's back pressure, gauge; it cavitates at "
+                                   "u = -(back pressure + 99.0 kPa))");
   c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
                                          "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
   if (const toml::node* n = t.raw("path")) parseStressPath(*n, baseDir, inputFilesMustExist, c.test);
@@ -1293,6 +1300,7 @@ toml::table resolvedTable(const lab::RunConfig& c) {
   put(test, "test", "csr", c.test.csr);
   put(test, "test", "n_cycles", c.test.nCycles);
   put(test, "test", "ru_limit", c.test.ruLimit);
+  if (c.test.backPressure) put(test, "test", "back_pressure", *c.test.backPressure);
   put(test, "test", "liquefaction_da_strain", c.test.liquefactionDaStrain);
   {
     toml::array amplitudes;

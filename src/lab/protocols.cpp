@@ -324,6 +324,7 @@ void Laboratory::saveState(std::ostream& out) const {
     using S = ProtocolState;
     putFields(out, protocol_->state, &S::direction, &S::path, &S::lastEps1, &S::halfCycles, &S::cycleEpsMin,
               &S::cycleEpsMax, &S::doubleAmplitude, &S::ruMax, &S::liquefiedCycles, &S::volumeDriftMax, &S::done,
+              &S::cavitated, &S::drainageOpen, &S::cavitations, &S::cavitationStrain, &S::cavityMax,
               &S::recordDue, &S::lastRecorded, &S::segment, &S::segmentStart, &S::target, &S::stressDeviationMax,
               &S::pathFailed, &S::gamma0, &S::amplitude, &S::returning, &S::lastGamma, &S::lastTau, &S::cycleGammaMin,
               &S::cycleGammaMax, &S::cycleTauMin, &S::cycleTauMax, &S::loopArea, &S::secantModulus, &S::dampingRatio,
@@ -349,7 +350,10 @@ void Laboratory::loadState(std::istream& in) {
     const ProtocolState& ps = protocol_->state;
     if ((ps.direction != 1 && ps.direction != -1) || !(ps.path >= 0.0) || !std::isfinite(ps.path) || ps.halfCycles < 0 ||
         !std::isfinite(ps.lastEps1) || !std::isfinite(ps.ruMax) || !(ps.volumeDriftMax >= 0.0) ||
-        !std::isfinite(ps.volumeDriftMax))
+        !std::isfinite(ps.volumeDriftMax) || ps.cavitations < 0 || !std::isfinite(ps.cavitationStrain) ||
+        ((ps.cavitated || ps.drainageOpen || ps.cavitations > 0) && !config_.test.cavitationPressure()) ||
+        (ps.cavitations > 0) != (ps.cavitationStrain >= 0.0) || (ps.cavitated && ps.cavitations == 0) ||
+        !(ps.cavityMax >= 0.0) || !std::isfinite(ps.cavityMax))
       throw std::runtime_error("inconsistent state: the shearing protocol's state");
     boundary_->restoreReference(st.l0, st.v0);
   } else {

@@ -206,6 +206,18 @@ struct TestConfig {
   double csr = 0.2;
   long nCycles = 20;
   double ruLimit = 0.95;
+  // Undrained tests: the back pressure of the pore water [Pa, gauge]; nullopt: no cavitation limit
+  // (the water takes any tension). With it the water cavitates where its absolute pressure falls to
+  // its vapour pressure, at u = cavitationPressure() (docs/laboratory.md, "Cavitation").
+  std::optional<double> backPressure;
+  // The excess pore pressure at which the water cavitates [Pa, negative]: -(back pressure +
+  // atmospheric pressure - vapour pressure of water at 20 degC); nullopt without test.back_pressure.
+  static constexpr double kAtmosphericPressure = 101325.0;
+  static constexpr double kVapourPressure = 2339.0;
+  std::optional<double> cavitationPressure() const {
+    if (!backPressure) return std::nullopt;
+    return -(*backPressure + kAtmosphericPressure - kVapourPressure);
+  }
   double liquefactionDaStrain = 0.05;
   // Stress path (test.path): its points, and the file they were read from ("" when given inline).
   std::vector<PathPoint> path;

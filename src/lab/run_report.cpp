@@ -172,25 +172,40 @@ Json underCompactionJson(const UnderCompactionReport& u, double d50, ConsoleWarn
   return j;
 }
 
-// volume_drift_max of an undrained test, with a warning above what the boundary should hold.
-void volumeDriftKeys(const RunConfig& config, double drift, Json& s) {
+// The keys of an undrained test's volume constraint: volume_drift_max, with a warning above what
+// the boundary should hold, and cavitation (test.back_pressure).
+void volumeDriftKeys(const RunConfig& config, const ProtocolState& ps, Json& s) {
+  const double drift = ps.volumeDriftMax;
   s["volume_drift_max"] = drift;
   const double allowed = config.test.boundary == "periodic" ? 1e-6 : 1e-5;
   if (drift > allowed)
     s["warnings"].push_back(
         fmt::format("the volume drifted by up to {:.3g} during the undrained test (> {:g})", drift, allowed));
+  const std::optional<double> uCav = config.test.cavitationPressure();
+  s["cavitation_pressure"] = optional(uCav);
+  s["cavitated"] = uCav ? Json(ps.cavitations > 0) : Json(nullptr);
+  s["cavitations"] = uCav ? Json(ps.cavitations) : Json(nullptr);
+  s["cavitation_strain"] = ps.cavitations > 0 ? Json(ps.cavitationStrain) : Json(nullptr);
+  if (uCav && ps.cavitations > 0)
+    s["warnings"].push_back(fmt::format(
+        "the pore water cavitated (u fell to {:.4g} kPa, test.back_pressure = {:g} Pa) at a strain of {:.4g}{}: "
+        "while cavitated the test was drained at sigma' = p0 - u_cav, so volume_drift_max covers the undrained "
+        "parts only",
+        *uCav / 1e3, *config.test.backPressure, ps.cavitationStrain,
+        ps.cavitations > 1 ? fmt::format(" ({} times)", ps.cavitations) : std::string()));
 }
 
 // The undrained keys (lab/test_report.hpp), with a warning where the volume was not held.
-void undrainedKeys(const RunConfig& config, const std::vector<Record>& records, double volumeDriftMax, Json& s) {
+void undrainedKeys(const RunConfig& config, const std::vector<Record>& records, const ProtocolState& ps, Json& s) {
   const UndrainedSummary u =
-      undrainedSummary(records, config.test.confiningPressure, config.test.ruLimit, volumeDriftMax);
+      undrainedSummary(records, config.test.confiningPressure, config.test.ruLimit, ps.volumeDriftMax);
   s["u_max"] = finite(u.uMax, "u_max");
   s["p_min"] = finite(u.pMin, "p_min");
   s["q_at_phase_transformation"] = optional(u.qAtPhaseTransformation);
   s["eps1_at_phase_transformation"] = optional(u.eps1AtPhaseTransformation);
   s["liquefied"] = u.liquefied;
-  volumeDriftKeys(config, u.volumeDriftMax, s);
+  s["u_min"] = finite(u.uMin, "u_min");
+  volumeDriftKeys(config, ps, s);
 }
 
 // Eur of each unload–reload loop (lab/moduli.hpp); null when the test had no loop.
@@ -311,7 +326,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
       "critical_state_eps1 to the end, end_* those of the last window",
       criterion.csWindow, simpleShear ? "shear strain" : "axial strain", criterion.csMaxStressRatioRate,
       criterion.csMaxVolumetricRate, criterion.csMaxVoidRatioRate, criterion.csMinRecords);
-  if (lab.protocol()->undrained()) undrainedKeys(config, records, lab.protocol()->state.volumeDriftMax, s);
+  if (lab.protocol()->undrained()) undrainedKeys(config, records, lab.protocol()->state, s);
   s["strain_rate"] = shear.strainRate;
   s["inertial_number"] = shear.inertialNumber;
   if (config.test.rateFollowsPressure) s["rate_factor_min"] = shear.rateFactorMin;
@@ -420,7 +435,7 @@ void reportReversing(const RunConfig& config, const ShearResult& shear, Laborato
           "small-strain modulus",
           config.test.shearStrainAmplitudes[0]));
     s["ru_max"] = protocol.undrained() ? Json(ps.ruMax) : Json(nullptr);
-    if (protocol.undrained()) volumeDriftKeys(config, ps.volumeDriftMax, s);
+    if (protocol.undrained()) volumeDriftKeys(config, ps, s);
   } else if (config.test.type == TestType::StressPath) {
     const ProtocolState& ps = protocol.state;
     const double sEnd = config.test.path.back().s;
@@ -450,7 +465,7 @@ void reportReversing(const RunConfig& config, const ShearResult& shear, Laborato
         "happened in (0.5: the first compression)",
         protocol.undrained() ? fmt::format("ru = 1 - p'/p0 >= {} or ", config.test.ruLimit) : std::string(),
         config.test.liquefactionDaStrain);
-    if (protocol.undrained()) volumeDriftKeys(config, protocol.state.volumeDriftMax, s);
+    if (protocol.undrained()) volumeDriftKeys(config, protocol.state, s);
   }
   s["strain_rate"] = shear.strainRate;
   s["inertial_number"] = shear.inertialNumber;

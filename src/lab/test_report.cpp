@@ -10,9 +10,10 @@ UndrainedSummary undrainedSummary(const std::vector<Record>& records, double p0,
   s.volumeDriftMax = volumeDriftMax;
   if (records.empty()) return s;
   std::size_t iMin = 0;
-  s.uMax = records[0].u;
+  s.uMax = s.uMin = records[0].u;
   for (std::size_t i = 0; i < records.size(); ++i) {
     s.uMax = std::max(s.uMax, records[i].u);
+    s.uMin = std::min(s.uMin, records[i].u);
     if (records[i].p < records[iMin].p) iMin = i;
   }
   s.pMin = records[iMin].p;

@@ -11,6 +11,7 @@ namespace grainlab::lab {
 
 struct UndrainedSummary {
   double uMax = 0.0;           // largest excess pore pressure [Pa]
+  double uMin = 0.0;           // smallest (most negative) excess pore pressure [Pa]
   double pMin = 0.0;           // smallest mean effective stress [Pa]
   // Deviator where the effective stress path turns from contractive to dilative (the minimum of p'
   // between the first and the last record); null where p' only rises or only falls.

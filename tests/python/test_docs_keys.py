@@ -231,7 +231,8 @@ SUMMARY_ONLY_SOMETIMES = {
     "Eur_at_eps1",                         # runs with unload-reload loops
     "error",                               # failed runs
     # undrained tests
-    "u_max", "p_min", "q_at_phase_transformation", "eps1_at_phase_transformation", "liquefied", "volume_drift_max",
+    "u_max", "u_min", "cavitation_pressure", "cavitated", "cavitations", "cavitation_strain",
+    "p_min", "q_at_phase_transformation", "eps1_at_phase_transformation", "liquefied", "volume_drift_max",
     # oedometer
     "K0", "K0_unloading", "Cc", "Cs", "sigma_v_max", "oedometer_method",
     # cyclic triaxial

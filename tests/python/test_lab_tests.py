@@ -56,6 +56,55 @@ def test_undrained_triaxial_holds_the_volume_and_reports_u(tmp_path, boundary, a
     assert isinstance(s["liquefied"], bool)
 
 
+ATMOSPHERIC, VAPOUR = 101325.0, 2339.0  # Pa: the numbers docs/laboratory.md states for cavitation
+
+
+def test_cavitation_caps_the_suction_and_drains_the_sample(tmp_path):
+    """A dense sample sheared undrained dilates, and u falls far below -p0 (the ideal constraint:
+    water that takes any tension). With test.back_pressure = 0 the water cavitates at
+    u_cav = -(0 + 101.325 - 2.339) kPa: u then stays there, the lateral effective stress is held
+    at p0 - u_cav and the volume grows; before it, the volume held."""
+    common = ['test.drainage="undrained"', 'test.boundary="periodic"', "test.final_axial_strain=0.04",
+              "sample.e0_tolerance=1.0", "test.probe_strain=0"]
+    ideal, si = run(tmp_path / "ideal", *common)
+    u_cav = -(0.0 + ATMOSPHERIC - VAPOUR)
+    # Without the limit the same sample's suction goes beyond u_cav (else this test could not fail).
+    assert si["u_min"] < 1.5 * u_cav and si["cavitated"] is None and si["cavitation_pressure"] is None
+    c, s = run(tmp_path / "cav", *common, "test.back_pressure=0")
+    p0 = s["confining_pressure"]
+    assert s["cavitation_pressure"] == u_cav
+    assert s["cavitated"] is True and s["cavitations"] >= 1
+    e_cav = s["cavitation_strain"]
+    assert 0.0 < e_cav < 0.04
+    # The ideal run passes u_cav at the same strain (identical until then).
+    k = np.argmax(ideal["u"] <= u_cav)
+    assert ideal["eps1"][k] == pytest.approx(e_cav, abs=2e-3)
+    before, after = c["eps1"] < e_cav, c["eps1"] > e_cav + 0.005
+    assert before.sum() > 3 and after.sum() > 3
+    assert np.abs(c["eps_v"][before]).max() <= 1e-6 and s["volume_drift_max"] <= 1e-6
+    assert (c["u"][before] > u_cav).all()
+    # Cavitated: u = p0 - sigma3' held at u_cav to the servo's tolerance, the sample dilates
+    # (eps_v < 0: compression positive) and p' stays far below the ideal run's.
+    assert np.abs(c["u"][after] - u_cav).max() < 0.05 * p0
+    assert c["eps_v"][-1] < -1e-3 and np.all(np.diff(c["eps_v"][after]) < 1e-6)
+    assert c["p"][-1] < 0.7 * ideal["p"][-1]
+    assert s["u_min"] == pytest.approx(c["u"].min())
+    assert any("cavitated" in w for w in s["warnings"])
+
+
+def test_cavitation_in_undrained_simple_shear_holds_sigma_zz(tmp_path):
+    """Simple shear keeps the volume with H_zz fixed: cavitated, sigma_zz is held at p0 - u_cav."""
+    c, s = run(tmp_path / "ss", 'test.type="simple-shear"', 'test.boundary="periodic"', 'test.drainage="undrained"',
+               "test.back_pressure=0", "test.final_shear_strain=0.12", "sample.e0_tolerance=1.0", "test.probe_strain=0")
+    u_cav, p0 = -(ATMOSPHERIC - VAPOUR), s["confining_pressure"]
+    assert s["cavitated"] is True and s["volume_drift_max"] <= 1e-6
+    after = c["gamma"] > c["gamma"][0] + s["cavitation_strain"] + 0.005
+    assert after.sum() > 3
+    assert np.abs(c["sigma1"][after] - (p0 - u_cav)).max() < 0.05 * p0
+    assert np.allclose(c["u"], p0 - c["sigma1"], rtol=0, atol=1e-7 * p0)
+    assert c["eps_v"][-1] < -1e-3
+
+
 def local_rates(c, ramp_steps):
     """(dε1/dt between consecutive records, mean p of the interval) after the loading ramp."""
     t, e1, p, step = c["time"], c["eps1"], c["p"], c["step"]
@@ -146,6 +195,7 @@ VOLATILE = {"wall_seconds", "particle_steps_per_s", "threads_used", "run_id"}
     ['test.type="oedometer"', "test.max_axial_stress=800e3", "test.unload_axial_stress=200e3"],
     ['test.type="cyclic-triaxial"', 'test.drainage="undrained"', "test.csr=0.15", "test.n_cycles=2"],
     ['test.drainage="undrained"', "test.final_axial_strain=0.02"],
+    ['test.drainage="undrained"', "test.final_axial_strain=0.02", "test.back_pressure=0", 'test.boundary="periodic"'],
 ])
 def test_kill_and_resume_is_bit_identical(tmp_path, test):
     extra = test + ["sample.e0_tolerance=1.0", "output.checkpoint_every=1e-4"]
@@ -173,6 +223,8 @@ def test_kill_and_resume_is_bit_identical(tmp_path, test):
     (['test.type="cyclic-triaxial"', "test.liquefaction_da_strain=0.9"], "test.liquefaction_da_strain", ["(0, 0.5]"]),
     (['test.type="stress-path"'], "test.path", ['needs its table']),
     (['test.rate_follows_pressure="yes"'], "test.rate_follows_pressure", ["true", "false"]),
+    (['test.drainage="undrained"', "test.back_pressure=-1"], "test.back_pressure", ["[0, 1e9]", "cavitates"]),
+    (['test.drainage="undrained"', 'test.back_pressure="high"'], "test.back_pressure", ["number"]),
 ])
 def test_bad_input_of_the_new_tests_is_refused(tmp_path, extra, key, words):
     proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets(*extra)], capture_output=True, text=True, timeout=60)
@@ -195,3 +247,12 @@ def test_keys_of_another_test_warn(extra, key):
     proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets(*extra)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert f"warning: {key} = " in proc.stderr and "is ignored" in proc.stderr and "test.type" in proc.stderr
+
+
+def test_back_pressure_of_a_drained_test_warns():
+    """test.back_pressure only means something when the volume is held: a drained test ignores it,
+    with a warning naming test.drainage."""
+    proc = subprocess.run([GRAINLAB, "check", CONFIG, *sets("test.back_pressure=300e3")], capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "warning: test.back_pressure = " in proc.stderr and "test.drainage" in proc.stderr

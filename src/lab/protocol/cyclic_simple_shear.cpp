@@ -46,6 +46,7 @@ class CyclicSimpleShear final : public ShearProtocol {
     resetCycle(0.0, state.lastTau);
   }
   void drive(BoundaryControl& b, double rate, double factor) override {
+    if (undrained()) updateDrainage(b);
     if (state.done) {
       b.imposeShearRate(0.0);
       return;
@@ -66,10 +67,7 @@ class CyclicSimpleShear final : public ShearProtocol {
     state.cycleGammaMax = std::max(state.cycleGammaMax, gamma);
     state.cycleTauMin = std::min(state.cycleTauMin, tau);
     state.cycleTauMax = std::max(state.cycleTauMax, tau);
-    if (undrained()) {
-      state.volumeDriftMax = std::max(state.volumeDriftMax, std::abs(b.volumetricStrain()));
-      state.ruMax = std::max(state.ruMax, 1.0 - b.stress()[2] / config_.test.confiningPressure);
-    }
+    if (undrained()) trackUndrained(b);
     const std::vector<double>& amplitudes = config_.test.shearStrainAmplitudes;
     const double a = amplitudes[state.amplitude];
     if (std::abs(gamma - state.lastRecorded) >= kRecordFraction * a) state.recordDue = true;
@@ -108,6 +106,13 @@ class CyclicSimpleShear final : public ShearProtocol {
       state.recordDue = true;
     }
   }
+  // Undrained: u is the fall of sigma_zz from p0; cavitated, sigma_zz is held at p0 - u_cav.
+  double porePressure(const BoundaryControl& b) const override { return config_.test.confiningPressure - b.stress()[2]; }
+  double porePressureRatio(const BoundaryControl& b) const override {
+    return 1.0 - b.stress()[2] / config_.test.confiningPressure;
+  }
+  void openDrainage(BoundaryControl& b, double effectiveStress) override { b.holdStress(2, effectiveStress); }
+  void closeDrainage(BoundaryControl& b) override { b.fix(2); }
   void recorded(const Record& r) override {
     state.recordDue = false;
     state.lastRecorded = r.gamma - state.gamma0;

@@ -30,6 +30,7 @@ class CyclicTriaxial final : public ShearProtocol {
     b.imposeStrainRate(2, 0.0);
   }
   void drive(BoundaryControl& b, double rate, double factor) override {
+    if (undrained()) updateDrainage(b);
     b.imposeStrainRate(2, rate, factor * state.direction);
   }
   void afterStep(const BoundaryControl& b) override {

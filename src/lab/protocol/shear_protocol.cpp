@@ -39,8 +39,34 @@ void ShearProtocol::afterStep(const BoundaryControl& b) {
 }
 
 void ShearProtocol::trackUndrained(const BoundaryControl& b) {
-  state.volumeDriftMax = std::max(state.volumeDriftMax, std::abs(b.volumetricStrain()));
-  state.ruMax = std::max(state.ruMax, poreRatio(b.stress()));
+  const double epsV = b.volumetricStrain();
+  // The drift is what the constraint lets through: not the cavities' volume while cavitated.
+  if (!state.cavitated) state.volumeDriftMax = std::max(state.volumeDriftMax, std::abs(epsV));
+  state.ruMax = std::max(state.ruMax, porePressureRatio(b));
+  const std::optional<double> uCav = config_.test.cavitationPressure();
+  if (!uCav) return;
+  if (!state.cavitated && porePressure(b) <= *uCav) {
+    state.cavitated = true;
+    ++state.cavitations;
+    if (state.cavitationStrain < 0.0) state.cavitationStrain = std::max(0.0, strain(b));
+    state.cavityMax = 0.0;
+    state.recordDue = true;
+  } else if (state.cavitated) {
+    state.cavityMax = std::max(state.cavityMax, -epsV);
+  }
+  if (state.cavitated && state.cavityMax >= kCavityOpen && epsV >= 0.0) {
+    // Back at (or below) the initial volume: the vapour has condensed, the water is continuous
+    // again and takes tension or pressure as before.
+    state.cavitated = false;
+    state.recordDue = true;
+  }
+}
+
+void ShearProtocol::updateDrainage(BoundaryControl& b) {
+  if (state.cavitated == state.drainageOpen) return;
+  if (state.cavitated) openDrainage(b, config_.test.confiningPressure - *config_.test.cavitationPressure());
+  else closeDrainage(b);
+  state.drainageOpen = state.cavitated;
 }
 
 std::optional<Vec3> ShearProtocol::lateralTargets(double) const { return std::nullopt; }

@@ -29,6 +29,16 @@ struct ProtocolState {
   double liquefiedCycles = -1.0;  // cyclic: cycles to liquefaction (-1: not liquefied)
   double volumeDriftMax = 0.0;  // undrained: largest |eps_v| of any step
   bool done = false;            // the protocol's own end (oedometer unloaded, cyclic stopped)
+  // Undrained with test.back_pressure: whether the pore water is cavitated now (its pressure held at
+  // the cavitation pressure, the drained axes at the effective stress that gives), whether the
+  // boundary's controls say so (they switch before the next step), how often it cavitated, and the
+  // strain (the protocol's strain()) of the first cavitation (-1: never).
+  bool cavitated = false;
+  bool drainageOpen = false;
+  long cavitations = 0;
+  double cavitationStrain = -1.0;
+  // Cavitated: the largest volume of the cavities (-eps_v) since the water cavitated.
+  double cavityMax = 0.0;
   // Records the protocol asks for besides those spaced in progress(): at a reversal, and once the
   // recorded quantity (oedometer: log10 sigma_v; cyclic: q) has moved by the protocol's step since
   // the last record.
@@ -88,6 +98,11 @@ class ShearProtocol {
   // Lateral stress targets (x, y) the boundary is meant to hold, for how well it held them; none
   // where the lateral axes are strain-controlled.
   virtual std::optional<Vec3> lateralTargets(double sigma1) const;
+  // Undrained: the excess pore pressure the volume constraint produces now, and the pore-pressure
+  // ratio of the liquefaction criteria (triaxial: from the lateral stresses and p'; simple shear:
+  // from sigma_zz).
+  virtual double porePressure(const BoundaryControl& b) const { return excessPorePressure(b.stress()); }
+  virtual double porePressureRatio(const BoundaryControl& b) const { return poreRatio(b.stress()); }
   // The protocol's own columns of a record (u, cycle).
   virtual void completeRecord(Record& r) const;
   // Whether the protocol wants a record after this step (ProtocolState::recordDue), and the record
@@ -107,7 +122,26 @@ class ShearProtocol {
   // Excess pore pressure of an undrained test: the total lateral stress stays the cell pressure p0,
   // the effective one is what the grains carry.
   double excessPorePressure(const Vec3& sigma) const { return config_.test.confiningPressure - 0.5 * (sigma[0] + sigma[1]); }
+  // After a step of an undrained test: the volume drift while the volume is held, ru, and
+  // cavitation (test.back_pressure): the water cavitates once u falls to the cavitation pressure,
+  // and the cavities close again when the sample has contracted back to its initial volume (once
+  // they have opened by kCavityOpen: right after the switch the stress servo lags the platen, and
+  // the volume first shrinks by a few 1e-6; closing there would chatter between the two controls).
   void trackUndrained(const BoundaryControl& b);
+  static constexpr double kCavityOpen = 1e-5;
+  // Before a step of an undrained test (at the start of drive()): the boundary's controls follow
+  // the cavitation state, through the two hooks below.
+  void updateDrainage(BoundaryControl& b);
+  // Cavitated: the axes that kept the volume hold the effective stress p0 - u_cav instead (the total
+  // stress stays p0, the pore pressure u_cav). Closed: they keep the volume again.
+  virtual void openDrainage(BoundaryControl& b, double effectiveStress) {
+    b.holdStress(0, effectiveStress);
+    b.holdStress(1, effectiveStress);
+  }
+  virtual void closeDrainage(BoundaryControl& b) {
+    b.constantVolume(0);
+    b.constantVolume(1);
+  }
   // The excess pore-pressure ratio of the liquefaction criteria, ru = 1 - p'/p0: u less the q/3 of
   // the total stress path (with the cell pressure held, p_total = p0 + q/3), the same as u/p0
   // wherever q = 0.

@@ -19,7 +19,10 @@ class SimpleShear final : public ShearProtocol {
     if (undrained()) b.fix(2);
     else b.holdStress(2, config_.test.confiningPressure);
   }
-  void drive(BoundaryControl& b, double rate, double factor) override { b.imposeShearRate(rate, factor); }
+  void drive(BoundaryControl& b, double rate, double factor) override {
+    if (undrained()) updateDrainage(b);
+    b.imposeShearRate(rate, factor);
+  }
   double strain(const BoundaryControl& b) const override {
     const Mat3& h = b.simulation().cell.h;
     return h(0, 2) / h(2, 2);
@@ -29,10 +32,15 @@ class SimpleShear final : public ShearProtocol {
     return std::min(1.0, strain(b) / config_.test.finalShearStrain);
   }
   void afterStep(const BoundaryControl& b) override {
-    if (!undrained()) return;
-    state.volumeDriftMax = std::max(state.volumeDriftMax, std::abs(b.volumetricStrain()));
-    state.ruMax = std::max(state.ruMax, 1.0 - b.stress()[2] / config_.test.confiningPressure);
+    if (undrained()) trackUndrained(b);
   }
+  // Undrained: u is the fall of sigma_zz from p0; cavitated, sigma_zz is held at p0 - u_cav.
+  double porePressure(const BoundaryControl& b) const override { return config_.test.confiningPressure - b.stress()[2]; }
+  double porePressureRatio(const BoundaryControl& b) const override {
+    return 1.0 - b.stress()[2] / config_.test.confiningPressure;
+  }
+  void openDrainage(BoundaryControl& b, double effectiveStress) override { b.holdStress(2, effectiveStress); }
+  void closeDrainage(BoundaryControl& b) override { b.fix(2); }
   void completeRecord(Record& r) const override {
     if (undrained()) r.u = config_.test.confiningPressure - r.sigma1;
   }

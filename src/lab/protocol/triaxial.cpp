@@ -20,6 +20,7 @@ void AxialCompression::configure(BoundaryControl& b) {
 }
 
 void AxialCompression::drive(BoundaryControl& b, double rate, double factor) {
+  if (undrained()) updateDrainage(b);
   b.imposeStrainRate(2, rate, factor);
   if (followsAxialStress()) {
     // The stress path: lateral targets follow the axial stress of the previous step.
