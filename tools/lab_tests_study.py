@@ -105,8 +105,10 @@ def mean_sd(values):
 def css_report(done, group, title, png, table):
     """The G/Gmax and damping table and plot of one cyclic simple shear group."""
     per_amp = {}
-    lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | wall [s] |",
-             "|---:|---:|---:|---:|---|---|---:|"]
+    undrained = group == "ucss"
+    lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | "
+             + ("σzz max [kPa] | σzz end [kPa] | volume drift max | " if undrained else "") + "wall [s] |",
+             "|---:|---:|---:|---:|---|---|" + ("---:|---:|---:|" if undrained else "") + "---:|"]
     fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
     for name, (g, preset, s, d) in sorted(done.items()):
         if g != group:
@@ -117,7 +119,9 @@ def css_report(done, group, title, png, table):
         gp = s["E0_MPa"] / (2 * (1 + s["nu0"])) if s.get("E0_MPa") and s.get("nu0") is not None else None
         lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
                      + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
-                     + ", ".join(f"{100 * x:.2f}" for x in xi) + f" | {s['wall_seconds']:.0f} |")
+                     + ", ".join(f"{100 * x:.2f}" for x in xi) + " | "
+                 + (f"{max(d['sigma1']) / 1e3:.0f} | {d['sigma1'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
+                    if undrained else "") + f"{s['wall_seconds']:.0f} |")
         axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
         axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
     axg.set_xlabel("shear strain amplitude γa")
@@ -283,6 +287,36 @@ def report(a):
             median = statistics.median(ns) if all(n is not None for n in ns) else None
             lines.append(f"| {csr:g} | {len(v)} | {sum(n is not None for n in ns)} | {', '.join(shown)} | {fmt(median)} |")
         write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
+    # Dense undrained with cavitation (test.back_pressure).
+    if "cav" in a.only:
+        lines = ["| seed | e0 | u_cav [kPa] | ε1 at cavitation [%] | u min [kPa] | q peak [kPa] | ε1 at peak [%] | "
+                 "φ peak [°] | p′ end [kPa] | q end [kPa] | εv end [%] | volume drift max (undrained part) | wall [s] |",
+                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        fig, (ax, axv) = plt.subplots(1, 2, figsize=(11, 4.2))
+        for name, (g, preset, s, d) in sorted(done.items()):
+            if g != "cav":
+                continue
+            ce = s["cavitation_strain"]
+            lines.append(f"| {s['seed']} | {s['e0']:.3f} | {s['cavitation_pressure'] / 1e3:.1f} | "
+                         f"{fmt(100 * ce if ce is not None else None)} | {s['u_min'] / 1e3:.1f} | "
+                         f"{s['q_peak'] / 1e3:.0f} | {100 * s['eps1_at_peak']:.1f} | {s['phi_peak_deg']:.1f} | "
+                         f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {100 * d['eps_v'][-1]:.1f} | "
+                         f"{s['volume_drift_max']:.1e} | {s['wall_seconds']:.0f} |")
+            ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], lw=0.9, label=f"seed {s['seed']}")
+            axv.plot([100 * e for e in d["eps1"]], [100 * v for v in d["eps_v"]], lw=0.9, label=f"seed {s['seed']}")
+        ax.set_xlabel("p′ [kPa]")
+        ax.set_ylabel("q [kPa]")
+        axv.set_xlabel("axial strain ε1 [%]")
+        axv.set_ylabel("εv [%] (compression positive)")
+        for x in (ax, axv):
+            x.grid(alpha=0.3)
+            x.legend(fontsize=8)
+        fig.suptitle("Undrained triaxial, dense, p0 = 200 kPa, back pressure 300 kPa (cavitation at u = −399 kPa)",
+                     fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "cavitation.png"), dpi=110)
+        plt.close(fig)
+        write_table(os.path.join(out_dir, "cavitation-table.md"), lines)
     # Cyclic simple shear, drained and undrained.
     for group, title, png, table in (("css", "Drained cyclic simple shear, dense, σzz = 200 kPa", "css.png", "css-table.md"),
                                      ("ucss", "Undrained (constant-volume) cyclic simple shear, dense, p0 = 200 kPa",
@@ -292,7 +326,7 @@ def report(a):
     # A group none of whose cases completed has no table or plot (not an empty one).
     files = {"cu": ("undrained-table.md", "undrained.png"), "cu-slow": ("undrained-rate-table.md", "undrained-rate.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
              "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png"),
-             "ucss": ("ucss-table.md", "ucss.png")}
+             "ucss": ("ucss-table.md", "ucss.png"), "cav": ("cavitation-table.md", "cavitation.png")}
     # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
     for g, names in files.items():
