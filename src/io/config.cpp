@@ -1088,8 +1088,9 @@ lab::RunConfig parseConfig(const toml::table& root, const std::string& baseDir, 
                             "must be in (0, 1] (excess pore-pressure ratio ru = 1 - p'/p0 at liquefaction)");
   if (t.raw("back_pressure"))
     c.test.backPressure = t.number("back_pressure", 0.0, 0.0, 1e9, false, false,
-                                   "must be in [0, 1e9] [Pa] (the pore water's back pressure, gauge; it cavitates at "
-                                   "u = -(back pressure + 99.0 kPa))");
+                                   fmt::format("must be in [0, 1e9] [Pa] (the pore water's back pressure, gauge; it "
+                                               "cavitates at u = -(back pressure + {:g} kPa))",
+                                               (lab::TestConfig::kAtmosphericPressure - lab::TestConfig::kVapourPressure) / 1e3));
   c.test.liquefactionDaStrain = t.number("liquefaction_da_strain", c.test.liquefactionDaStrain, 0.0, 0.5, true, false,
                                          "must be in (0, 0.5] (double-amplitude axial strain at liquefaction)");
   if (const toml::node* n = t.raw("path")) parseStressPath(*n, baseDir, inputFilesMustExist, c.test);

@@ -18,25 +18,20 @@
 // stay quasi-static too.
 #include <cmath>
 
-#include "lab/protocol/shear_protocol.hpp"
-#include "lab/protocols.hpp"
+#include "lab/protocol/simple_shear_base.hpp"
 
 namespace grainlab::lab {
 
 namespace {
-class CyclicSimpleShear final : public ShearProtocol {
+class CyclicSimpleShear final : public SimpleShearBase {
  public:
-  using ShearProtocol::ShearProtocol;
+  using SimpleShearBase::SimpleShearBase;
   static constexpr double kMinQuarterSteps = 2000.0;
   static constexpr double kCyclicShearRateFactor = 0.1;
   static constexpr double kPi = 3.14159265358979323846;
 
   void configure(BoundaryControl& b) override {
-    b.holdShape();
-    b.fix(0);
-    b.fix(1);
-    if (undrained()) b.fix(2);
-    else b.holdStress(2, config_.test.confiningPressure);
+    configureNormal(b);
     state.gamma0 = gammaOf(b);
     state.lastGamma = 0.0;
     state.lastTau = tauOf(b);
@@ -106,13 +101,6 @@ class CyclicSimpleShear final : public ShearProtocol {
       state.recordDue = true;
     }
   }
-  // Undrained: u is the fall of sigma_zz from p0; cavitated, sigma_zz is held at p0 - u_cav.
-  double porePressure(const BoundaryControl& b) const override { return config_.test.confiningPressure - b.stress()[2]; }
-  double porePressureRatio(const BoundaryControl& b) const override {
-    return 1.0 - b.stress()[2] / config_.test.confiningPressure;
-  }
-  void openDrainage(BoundaryControl& b, double effectiveStress) override { b.holdStress(2, effectiveStress); }
-  void closeDrainage(BoundaryControl& b) override { b.fix(2); }
   void recorded(const Record& r) override {
     state.recordDue = false;
     state.lastRecorded = r.gamma - state.gamma0;
@@ -129,17 +117,13 @@ class CyclicSimpleShear final : public ShearProtocol {
     return std::min(1.0, (static_cast<double>(state.amplitudesDone) + within) / n);
   }
   void completeRecord(Record& r) const override {
-    if (undrained()) r.u = config_.test.confiningPressure - r.sigma1;
+    SimpleShearBase::completeRecord(r);
     r.cycle = 0.5 * static_cast<double>(state.halfCycles);
     r.loadDirection = state.direction;
     r.pathSegment = state.amplitude + 1;
   }
 
  private:
-  static double gammaOf(const BoundaryControl& b) {
-    const Mat3& h = b.simulation().cell.h;
-    return h(0, 2) / h(2, 2);
-  }
   // The shear stress the sample opposes to the shear (Record::tau): -sigma_xz.
   static double tauOf(const BoundaryControl& b) {
     const Mat3& s = b.simulation().cell.stress;
