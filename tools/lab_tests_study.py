@@ -39,7 +39,7 @@ CYCLIC = ['test.type="cyclic-triaxial"', 'test.drainage="undrained"', "test.n_cy
 # The loose undrained test again with the loading rate following p' (test.rate_follows_pressure),
 # beside the same samples at the fixed rate: is the flow's minimum p' a rate effect?
 CU_SLOW = CU + ["test.rate_follows_pressure=true"]
-CSRS = (0.15, 0.25)
+CSRS = (0.10, 0.15, 0.20, 0.25)
 # The dense undrained test again with cavitation of the pore water (test.back_pressure 300 kPa: it
 # cavitates at u = -399 kPa), beside the ideal constraint of "cu" (u falls to about -14 p0).
 CAV = CU + ["test.back_pressure=300e3"]
@@ -59,7 +59,7 @@ def cases(seeds, only):
             yield "cu-slow", "csl-loose", f"cu-loose-slow_s{seed}", CU_SLOW + s
         if "oedometer" in only:
             yield "oedometer", "csl-dense", f"oed-dense_s{seed}", OEDOMETER + s
-        if "cyclic" in only and seed <= 2:
+        if "cyclic" in only:
             for csr in CSRS:
                 yield "cyclic", "csl-loose", f"cyc-loose_csr{csr:g}_s{seed}", CYCLIC + [f"test.csr={csr}"] + s
         if "css" in only:
