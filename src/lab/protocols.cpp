@@ -324,7 +324,7 @@ void Laboratory::saveState(std::ostream& out) const {
     using S = ProtocolState;
     putFields(out, protocol_->state, &S::direction, &S::path, &S::lastEps1, &S::halfCycles, &S::cycleEpsMin,
               &S::cycleEpsMax, &S::doubleAmplitude, &S::ruMax, &S::liquefiedCycles, &S::volumeDriftMax, &S::done,
-              &S::cavitated, &S::drainageOpen, &S::cavitations, &S::cavitationStrain, &S::cavityMax,
+              &S::cavitated, &S::drainageOpen, &S::cavitations, &S::cavitationStrain, &S::cavityMax, &S::waterRecovered,
               &S::recordDue, &S::lastRecorded, &S::segment, &S::segmentStart, &S::target, &S::stressDeviationMax,
               &S::pathFailed, &S::gamma0, &S::amplitude, &S::returning, &S::lastGamma, &S::lastTau, &S::cycleGammaMin,
               &S::cycleGammaMax, &S::cycleTauMin, &S::cycleTauMax, &S::loopArea, &S::secantModulus, &S::dampingRatio,
@@ -353,7 +353,7 @@ void Laboratory::loadState(std::istream& in) {
         !std::isfinite(ps.volumeDriftMax) || ps.cavitations < 0 || !std::isfinite(ps.cavitationStrain) ||
         ((ps.cavitated || ps.drainageOpen || ps.cavitations > 0) && !config_.test.cavitationPressure()) ||
         (ps.cavitations > 0) != (ps.cavitationStrain >= 0.0) || (ps.cavitated && ps.cavitations == 0) ||
-        !(ps.cavityMax >= 0.0) || !std::isfinite(ps.cavityMax))
+        !(ps.cavityMax >= 0.0) || !std::isfinite(ps.cavityMax) || (ps.cavitations == 0 && !ps.waterRecovered))
       throw std::runtime_error("inconsistent state: the shearing protocol's state");
     boundary_->restoreReference(st.l0, st.v0);
   } else {

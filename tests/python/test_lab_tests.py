@@ -105,6 +105,34 @@ def test_cavitation_in_undrained_simple_shear_holds_sigma_zz(tmp_path):
     assert c["eps_v"][-1] < -1e-3
 
 
+def test_cavities_close_when_cyclic_shear_brings_the_sample_back_to_its_volume(tmp_path):
+    """Undrained cyclic simple shear of a dense sample: on each loading u falls to u_cav and the
+    water cavitates (drained at sigma_zz = p0 - u_cav, the sample dilates); on unloading the sample
+    contracts back to its initial volume, the cavities close, and u rises again. The sample can
+    never be denser than at the start while cavitated: a vapour cavity cannot carry compression
+    (before the fix the water re-cavitated on the step after each closing, at the servo's u_cav,
+    and the sample compacted by 1e-3 at u = u_cav)."""
+    c, s = run(tmp_path / "cyc", 'test.type="cyclic-simple-shear"', 'test.boundary="periodic"',
+               'test.drainage="undrained"', "test.back_pressure=0", "test.shear_strain_amplitudes=[0.01]",
+               "test.cycles_per_amplitude=2", "sample.e0_tolerance=1.0", "test.probe_strain=0")
+    u_cav, p0 = -(ATMOSPHERIC - VAPOUR), s["confining_pressure"]
+    margin = 5e-3 * (p0 - u_cav)  # kCavityMargin (docs/laboratory.md, Cavitation)
+    assert s["status"] == "completed" and s["cavitated"] is True
+    # Cavitated on every loading of the cycle (quarter, +, -, ...): several, not one.
+    assert s["cavitations"] >= 3
+    at_cav = np.abs(c["u"] - u_cav) < 0.002 * p0
+    assert at_cav.sum() > 5
+    # While cavitated the volume only grew: eps_v (compression positive) <= the constraint's drift.
+    assert c["eps_v"][at_cav].max() <= 1e-6
+    # Closed again: after the first cavitation u rises well above u_cav at constant volume.
+    first = np.argmax(at_cav)
+    closed = (c["u"] > u_cav + 0.1 * p0) & (np.arange(len(c["u"])) > first)
+    assert closed.sum() > 5
+    assert np.abs(c["eps_v"][closed]).max() <= 1e-6 and s["volume_drift_max"] <= 1e-6
+    # Never below u_cav by more than the re-cavitation margin.
+    assert c["u"].min() >= u_cav - margin
+
+
 def local_rates(c, ramp_steps):
     """(dε1/dt between consecutive records, mean p of the interval) after the loading ramp."""
     t, e1, p, step = c["time"], c["eps1"], c["p"], c["step"]

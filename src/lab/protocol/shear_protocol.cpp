@@ -45,7 +45,10 @@ void ShearProtocol::trackUndrained(const BoundaryControl& b) {
   state.ruMax = std::max(state.ruMax, porePressureRatio(b));
   const std::optional<double> uCav = config_.test.cavitationPressure();
   if (!uCav) return;
-  if (!state.cavitated && porePressure(b) <= *uCav) {
+  const double u = porePressure(b);
+  const double margin = kCavityMargin * (config_.test.confiningPressure - *uCav);
+  if (!state.cavitated && !state.waterRecovered && u > *uCav + margin) state.waterRecovered = true;
+  if (!state.cavitated && u <= *uCav - (state.waterRecovered ? 0.0 : margin)) {
     state.cavitated = true;
     ++state.cavitations;
     if (state.cavitationStrain < 0.0) state.cavitationStrain = std::max(0.0, strain(b));
@@ -58,6 +61,7 @@ void ShearProtocol::trackUndrained(const BoundaryControl& b) {
     // Back at (or below) the initial volume: the vapour has condensed, the water is continuous
     // again and takes tension or pressure as before.
     state.cavitated = false;
+    state.waterRecovered = false;
     state.recordDue = true;
   }
 }

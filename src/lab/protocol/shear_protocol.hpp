@@ -39,6 +39,9 @@ struct ProtocolState {
   double cavitationStrain = -1.0;
   // Cavitated: the largest volume of the cavities (-eps_v) since the water cavitated.
   double cavityMax = 0.0;
+  // Since the cavities last closed, u has risen above u_cav by kCavityMargin (true before any
+  // cavitation): until then the water cavitates again only below u_cav by that margin.
+  bool waterRecovered = true;
   // Records the protocol asks for besides those spaced in progress(): at a reversal, and once the
   // recorded quantity (oedometer: log10 sigma_v; cyclic: q) has moved by the protocol's step since
   // the last record.
@@ -127,8 +130,14 @@ class ShearProtocol {
   // and the cavities close again when the sample has contracted back to its initial volume (once
   // they have opened by kCavityOpen: right after the switch the stress servo lags the platen, and
   // the volume first shrinks by a few 1e-6; closing there would chatter between the two controls).
+  // Right after the cavities close, u is at u_cav to the stress servo's error: without a margin
+  // the water would cavitate again on the next step and the sample compact while "cavitated"
+  // (found in cyclic simple shear: eps_v reached +1e-3 with u held at u_cav). So after a closing
+  // the water cavitates again only once u <= u_cav - kCavityMargin (p0 - u_cav), or at u_cav once
+  // it has first risen above u_cav + that margin.
   void trackUndrained(const BoundaryControl& b);
   static constexpr double kCavityOpen = 1e-5;
+  static constexpr double kCavityMargin = 5e-3;
   // Before a step of an undrained test (at the start of drive()): the boundary's controls follow
   // the cavitation state, through the two hooks below.
   void updateDrainage(BoundaryControl& b);
