@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """The laboratory tests of issue 24 on the calibrated Karlsruhe sand (presets csl-dense and
 csl-loose: 2000 spheres, periodic cell, 200 kPa), with replicate seeds: undrained triaxial of a
-loose and a dense sample, the oedometer, cyclic triaxial at several CSRs, cyclic simple shear
+loose and a dense sample (and of the [W] law's base sample, preset w-base, for comparison), the
+oedometer, cyclic triaxial at several CSRs, cyclic simple shear drained and undrained
 (docs/results/lab-tests.md).
 
     /usr/bin/python3 tools/lab_tests_study.py run    [--runs runs/lab-tests] [--exe build/grainlab] [--jobs 2]
-                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css,ucss,cav]
+                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w]
     /usr/bin/python3 tools/lab_tests_study.py report [--runs runs/lab-tests] [--seeds 1,2,3]
                                                      [--out docs/results/lab-tests.md]
 
@@ -68,10 +69,14 @@ def cases(seeds, only):
             yield "cav", "csl-dense", f"cu-dense-bp300_s{seed}", CAV + s
         if "ucss" in only:
             yield "ucss", "csl-dense", f"ucss-dense_s{seed}", CSS + ['test.drainage="undrained"'] + s
+        if "ucss-loose" in only:
+            yield "ucss-loose", "csl-loose", f"ucss-loose_s{seed}", CSS + ['test.drainage="undrained"'] + s
+        if "cu-w" in only:
+            yield "cu-w", "w-base", f"cu-w_s{seed}", CU + ["output.vtk_every_strain=0"] + s
 
 
 def run(a):
-    for preset in ("csl-loose", "csl-dense"):
+    for preset in ("csl-loose", "csl-dense", "w-base"):
         todo = [(os.path.join(a.runs, name), sets) for g, p, name, sets in cases(a.seeds, a.only) if p == preset]
         run_cases(a.exe, f"preset:{preset}", todo, a.jobs)
     return 0
@@ -102,10 +107,51 @@ def mean_sd(values):
     return f"{statistics.mean(v):.3g} ± {statistics.stdev(v):.2g} ({len(v)} seeds)"
 
 
+def cu_report(done, group, title, png, table):
+    """The table and the q-p' / u-eps1 plot of one undrained triaxial group."""
+    lines = ["| sample | seed | e0 | p′ min [kPa] | u max [kPa] | q at PT [kPa] | ε1 at PT [%] | liquefied | "
+             "p′ end [kPa] | q end [kPa] | φ mobilised end [°] | volume drift max | wall [s] |",
+             "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+    fig, (ax, axu) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for name, (g, preset, s, d) in sorted(done.items()):
+        if g != group:
+            continue
+        pt_q, pt_e = s.get("q_at_phase_transformation"), s.get("eps1_at_phase_transformation")
+        sample = preset.split("-")[1]
+        p_end, q_end = d["p"][-1], d["q"][-1]
+        # Mobilised friction at the end from q/p' in compression: sin phi = 3 eta / (6 + eta).
+        eta = q_end / p_end if p_end > 0 else None
+        phi_end = math.degrees(math.asin(3 * eta / (6 + eta))) if eta is not None else None
+        lines.append(f"| {sample} | {s['seed']} | {s['e0']:.3f} | {s['p_min'] / 1e3:.1f} | "
+                     f"{s['u_max'] / 1e3:.1f} | {fmt(pt_q / 1e3 if pt_q is not None else None)} | "
+                     f"{fmt(100 * pt_e if pt_e is not None else None)} | {fmt(s['liquefied'])} | "
+                     f"{p_end / 1e3:.0f} | {q_end / 1e3:.0f} | {fmt(phi_end)} | {s['volume_drift_max']:.1e} | "
+                     f"{s['wall_seconds']:.0f} |")
+        colour = "tab:red" if "loose" in preset else ("tab:blue" if group == "cu" else f"C{s['seed'] - 1}")
+        ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], color=colour, lw=0.9,
+                label=f"{sample} s{s['seed']}")
+        axu.plot([100 * e for e in d["eps1"]], [u / s["confining_pressure"] for u in d["u"]], color=colour, lw=0.9)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("p′ [kPa] (log)")
+    ax.set_ylabel("q [kPa] (log)")
+    ax.legend(fontsize=7)
+    axu.set_xlabel("axial strain ε1 [%]")
+    axu.set_ylabel("u / p0")
+    axu.set_yscale("symlog", linthresh=1.0)
+    for x in (ax, axu):
+        x.grid(alpha=0.3, which="both")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    write_table(table, lines)
+
+
 def css_report(done, group, title, png, table):
     """The G/Gmax and damping table and plot of one cyclic simple shear group."""
     per_amp = {}
-    undrained = group == "ucss"
+    undrained = group.startswith("ucss")
     lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | "
              + ("σzz max [kPa] | σzz end [kPa] | volume drift max | " if undrained else "") + "wall [s] |",
              "|---:|---:|---:|---:|---|---|" + ("---:|---:|---:|" if undrained else "") + "---:|"]
@@ -156,40 +202,13 @@ def report(a):
         else:
             missing.append(name)
     lines = []
-    # Undrained triaxial.
+    # Undrained triaxial: the calibrated sand, and the [W] law's base sample for comparison.
     if "cu" in a.only:
-        lines.append("| sample | seed | e0 | p′ min [kPa] | u max [kPa] | q at PT [kPa] | ε1 at PT [%] | liquefied | "
-                     "p′ end [kPa] | q end [kPa] | volume drift max | wall [s] |")
-        lines.append("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|")
-        fig, (ax, axu) = plt.subplots(1, 2, figsize=(11, 4.2))
-        for name, (g, preset, s, d) in sorted(done.items()):
-            if g != "cu":
-                continue
-            pt_q, pt_e = s.get("q_at_phase_transformation"), s.get("eps1_at_phase_transformation")
-            lines.append(f"| {preset.split('-')[1]} | {s['seed']} | {s['e0']:.3f} | {s['p_min'] / 1e3:.1f} | "
-                         f"{s['u_max'] / 1e3:.1f} | {fmt(pt_q / 1e3 if pt_q is not None else None)} | "
-                         f"{fmt(100 * pt_e if pt_e is not None else None)} | {fmt(s['liquefied'])} | "
-                         f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
-                         f"{s['wall_seconds']:.0f} |")
-            colour = "tab:red" if "loose" in preset else "tab:blue"
-            ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], color=colour, lw=0.9,
-                    label=f"{preset.split('-')[1]} s{s['seed']}")
-            axu.plot([100 * e for e in d["eps1"]], [u / s["confining_pressure"] for u in d["u"]], color=colour, lw=0.9)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("p′ [kPa] (log)")
-        ax.set_ylabel("q [kPa] (log)")
-        ax.legend(fontsize=7)
-        axu.set_xlabel("axial strain ε1 [%]")
-        axu.set_ylabel("u / p0")
-        axu.set_yscale("symlog", linthresh=1.0)
-        for x in (ax, axu):
-            x.grid(alpha=0.3, which="both")
-        fig.suptitle("Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)", fontsize=10)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out_dir, "undrained.png"), dpi=110)
-        plt.close(fig)
-        write_table(os.path.join(out_dir, "undrained-table.md"), lines)
+        cu_report(done, "cu", "Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)",
+                  os.path.join(out_dir, "undrained.png"), os.path.join(out_dir, "undrained-table.md"))
+    if "cu-w" in a.only:
+        cu_report(done, "cu-w", "Undrained triaxial, the [W] law's base sample (w-base, e0 = 0.60), p0 = 100 kPa",
+                  os.path.join(out_dir, "undrained-w.png"), os.path.join(out_dir, "undrained-w-table.md"))
     # Undrained loose: fixed rate against the rate that follows p'.
     if "cu-slow" in a.only:
         lines = ["| rate | seed | e0 | p′ min [kPa] | ε1 at p′ min [%] | liquefied | I max | rate factor min | "
@@ -320,13 +339,16 @@ def report(a):
     # Cyclic simple shear, drained and undrained.
     for group, title, png, table in (("css", "Drained cyclic simple shear, dense, σzz = 200 kPa", "css.png", "css-table.md"),
                                      ("ucss", "Undrained (constant-volume) cyclic simple shear, dense, p0 = 200 kPa",
-                                      "ucss.png", "ucss-table.md")):
+                                      "ucss.png", "ucss-table.md"),
+                                     ("ucss-loose", "Undrained (constant-volume) cyclic simple shear, loose, p0 = 200 kPa",
+                                      "ucss-loose.png", "ucss-loose-table.md")):
         if group in a.only:
             css_report(done, group, title, os.path.join(out_dir, png), os.path.join(out_dir, table))
     # A group none of whose cases completed has no table or plot (not an empty one).
     files = {"cu": ("undrained-table.md", "undrained.png"), "cu-slow": ("undrained-rate-table.md", "undrained-rate.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
              "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png"),
-             "ucss": ("ucss-table.md", "ucss.png"), "cav": ("cavitation-table.md", "cavitation.png")}
+             "ucss": ("ucss-table.md", "ucss.png"), "cav": ("cavitation-table.md", "cavitation.png"),
+             "ucss-loose": ("ucss-loose-table.md", "ucss-loose.png"), "cu-w": ("undrained-w-table.md", "undrained-w.png")}
     # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
     for g, names in files.items():
@@ -345,7 +367,7 @@ def main():
     ap.add_argument("--exe", default="build/grainlab")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seeds", default="1,2,3")
-    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css,ucss,cav")
+    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w")
     ap.add_argument("--out", default="docs/results/lab-tests.md")
     a = ap.parse_args()
     a.seeds = [int(s) for s in a.seeds.split(",")]
