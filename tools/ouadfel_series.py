@@ -2,6 +2,7 @@
 """[O]'s constant mean stress series, with spheroids and with spheres of the same volume.
 
 Usage: ouadfel_series.py OUT [--grainlab BIN] [--jobs 2] [--particles 343] [--doc docs/results]
+                           [--seeds 2,3]
 
 For each shape (prolate spheroids b/a = 0.7 of preset ouadfel-spheroids, and spheres of the same
 volume prepared the same way), the grown sample is made and tested at p = 100 kPa (kappa = 25);
@@ -12,7 +13,13 @@ test; --unloading frictional keeps the friction on, the series published before 
 inertial number of 1e-4. Every run is one `grainlab run` (argument vector, no shell) into
 OUT/<shape>-<p>kPa. With --doc, writes the tables and plots of results/ouadfel.md there (into ouadfel/ for the
 frictional unloading, ouadfel-frictionless/ for [O]'s).
+
+--seeds 2,3 runs the whole series again for those sample seeds (sample.seed: the lattice's jitter),
+each into OUT/seed<N>/ (seed 1 is OUT itself); with --doc, seeds.md there gives, per shape and
+pressure, the mean and sample standard deviation over seed 1 and these, and the least-squares
+slope of phi_p against log10 p of each seed (the trend with pressure a referee asks about).
 """
+import statistics
 import argparse
 import csv
 import json
@@ -32,34 +39,86 @@ def rate(p):
     return INERTIAL / (DIAMETER * math.sqrt(DENSITY / p))
 
 
-def run(args, name, sets):
-    out = os.path.join(args.out, name)
+def run(args, name, sets, seed=1):
+    out = os.path.join(seed_dir(args, seed), name)
     if os.path.exists(os.path.join(out, "summary.json")):
         return out
     argv = [args.grainlab, "run", "preset:ouadfel-spheroids", "--out", out, "--threads", "1", "--quiet",
-            "--set", f"sample.n_particles={args.particles}", *sets]
+            "--set", f"sample.n_particles={args.particles}", "--set", f"sample.seed={seed}", *sets]
     proc = subprocess.run(argv, capture_output=True, text=True)
     if proc.returncode != 0:
         sys.exit(f"{name}: grainlab exit {proc.returncode}\n{proc.stderr[-2000:]}")
     return out
 
 
-def series(args):
-    def base(shape):
-        return run(args, f"{shape}-100kPa", SHAPES[shape] + ["--set", f"test.axial_strain_rate={rate(100e3)!r}"])
+def seed_dir(args, seed):
+    return args.out if seed == 1 else os.path.join(args.out, f"seed{seed}")
 
+
+def series(args, seeds):
+    def base(shape_seed):
+        shape, seed = shape_seed
+        return run(args, f"{shape}-100kPa", SHAPES[shape] + ["--set", f"test.axial_strain_rate={rate(100e3)!r}"], seed)
+
+    todo = [(shape, seed) for seed in seeds for shape in SHAPES]
     with ThreadPoolExecutor(args.jobs) as pool:
-        bases = dict(zip(SHAPES, pool.map(base, SHAPES)))
+        bases = dict(zip(todo, pool.map(base, todo)))
         jobs = []
-        for shape in SHAPES:
-            packing = os.path.join(bases[shape], "packing.txt")
+        for shape, seed in todo:
+            packing = os.path.join(bases[(shape, seed)], "packing.txt")
             for p in PRESSURES_KPA[1:]:
                 sets = ["--set", f'sample.packing="{packing}"', "--set", f"test.confining_pressure={p * 1e3!r}",
                         *(["--set", "sample.packing_friction_deg=0.0"] if args.unloading == "frictionless" else []),
                         "--set", f"test.axial_strain_rate={rate(p * 1e3)!r}"]
-                jobs.append(pool.submit(run, args, f"{shape}-{p}kPa", sets))
+                jobs.append(pool.submit(run, args, f"{shape}-{p}kPa", sets, seed))
         for j in jobs:
             j.result()
+
+
+def slope(xs, ys):
+    """Least-squares slope of ys against xs."""
+    mx, my = statistics.mean(xs), statistics.mean(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+
+
+def document_seeds(args, seeds, pictures):
+    """seeds.md: per shape and pressure, mean +- sample std over the seeds; phi_p's slope in log10 p."""
+    def ms(v, digits):
+        if len(v) < 2:
+            return f"{v[0]:.{digits}f}"
+        return f"{statistics.mean(v):.{digits}f} ± {statistics.stdev(v):.{digits}f}"
+
+    lines = [f"Seeds {', '.join(map(str, seeds))}: mean ± sample standard deviation.", "",
+             "| grains | p [kPa] | κ | e0 | Z0 | φp [°] | ε1 at peak [%] | φ at 20.5 % [°] | ψmax [°] | εv at 20.5 % [%] |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    slopes = {}
+    for shape in SHAPES:
+        per_seed = {seed: [] for seed in seeds}
+        for p in PRESSURES_KPA:
+            vals = {k: [] for k in ("e0", "Z0", "phi", "epk", "phiend", "psi", "ev")}
+            for seed in seeds:
+                rows, s = load(os.path.join(seed_dir(args, seed), f"{shape}-{p}kPa"))
+                last = rows[-1]
+                vals["e0"].append(s["e0"])
+                vals["Z0"].append(s["isotropic_state"]["coordination"])
+                vals["phi"].append(s["phi_peak_deg"])
+                vals["epk"].append(100 * s["eps1_at_peak"])
+                vals["phiend"].append(number(last["phi_deg"]))
+                vals["psi"].append(s["psi_max_deg"])
+                vals["ev"].append(100 * number(last["eps_v"]))
+                per_seed[seed].append((math.log10(p), s["phi_peak_deg"]))
+            lines.append(f"| {shape} | {p} | {KN / (p * 1e3 * DIAMETER):.0f} | {ms(vals['e0'], 3)} | {ms(vals['Z0'], 2)} | "
+                         f"{ms(vals['phi'], 1)} | {ms(vals['epk'], 1)} | {ms(vals['phiend'], 1)} | {ms(vals['psi'], 1)} | "
+                         f"{ms(vals['ev'], 2)} |")
+        slopes[shape] = [slope([x for x, _ in per_seed[seed]], [y for _, y in per_seed[seed]]) for seed in seeds]
+    lines += ["", "Slope of φp against log10 p (degrees per decade of p, 10 → 100 kPa), per seed:", "",
+              "| grains | " + " | ".join(f"seed {seed}" for seed in seeds) + " | mean ± std |",
+              "|---|" + "---:|" * (len(seeds) + 1)]
+    for shape in SHAPES:
+        v = slopes[shape]
+        lines.append(f"| {shape} | " + " | ".join(f"{x:+.2f}" for x in v) + f" | {ms(v, 2)} |")
+    with open(os.path.join(pictures, "seeds.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
 
 
 def load(folder):
@@ -149,12 +208,17 @@ def main():
     ap.add_argument("--unloading", choices=("frictionless", "frictional"), default="frictionless",
                     help="how the 100 kPa packing goes to the lower pressures ([O]: frictionless)")
     ap.add_argument("--doc", help="write results/ouadfel tables and plots into this folder")
+    ap.add_argument("--seeds", default="", help="further sample seeds (e.g. 2,3), each into OUT/seed<N>")
     args = ap.parse_args()
     args.grainlab = os.path.abspath(args.grainlab)
+    seeds = [1] + [int(x) for x in args.seeds.split(",") if x.strip() and int(x) != 1]
     os.makedirs(args.out, exist_ok=True)
-    series(args)
+    series(args, seeds)
     if args.doc:
         document(args)
+        if len(seeds) > 1:
+            document_seeds(args, seeds, os.path.join(args.doc, "ouadfel" if args.unloading == "frictional"
+                                                     else "ouadfel-frictionless"))
 
 
 if __name__ == "__main__":
