@@ -435,7 +435,31 @@ void reportReversing(const RunConfig& config, const ShearResult& shear, Laborato
           "small-strain modulus",
           config.test.shearStrainAmplitudes[0]));
     s["ru_max"] = protocol.undrained() ? Json(ps.ruMax) : Json(nullptr);
-    if (protocol.undrained()) volumeDriftKeys(config, ps, s);
+    if (protocol.undrained()) {
+      // Per amplitude, the largest ru = u/p0 recorded while it was cycled (records carry the
+      // amplitude's index + 1); liquefied: ru reached test.ru_limit at some step (ps.ruMax).
+      Json ruPer = Json::array();
+      std::optional<double> liquefiedAt;
+      const double p0 = config.test.confiningPressure;
+      for (std::size_t i = 0; i < n; ++i) {
+        double m = -std::numeric_limits<double>::infinity();
+        for (const Record& r : records)
+          if (r.pathSegment == static_cast<long>(i) + 1) m = std::max(m, r.u / p0);
+        ruPer.push_back(std::isfinite(m) ? Json(m) : Json(nullptr));
+        if (!liquefiedAt && std::isfinite(m) && m >= config.test.ruLimit) liquefiedAt = ps.measuredAmplitude[i];
+      }
+      const bool liquefied = ps.ruMax >= config.test.ruLimit;
+      s["ru_max_per_amplitude"] = ruPer;
+      s["liquefied"] = liquefied;
+      s["liquefied_at_amplitude"] = optional(liquefiedAt);
+      if (liquefied)
+        s["warnings"].push_back(fmt::format(
+            "the sample liquefied (ru = u/p0 reached {:.4g} >= test.ru_limit = {}){}: G/Gmax and the damping ratio "
+            "from there on are those of a liquefied sample (sigma_zz near zero), not of the soil's modulus curve",
+            ps.ruMax, config.test.ruLimit,
+            liquefiedAt ? fmt::format(" in the cycles at gamma_a = {:.3g}", *liquefiedAt) : std::string()));
+      volumeDriftKeys(config, ps, s);
+    }
   } else if (config.test.type == TestType::StressPath) {
     const ProtocolState& ps = protocol.state;
     const double sEnd = config.test.path.back().s;

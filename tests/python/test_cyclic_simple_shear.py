@@ -73,6 +73,27 @@ def test_undrained_cycles_hold_the_volume(tmp_path):
     assert np.allclose(c["u"], p0 - c["sigma1"], rtol=0, atol=1e-7 * p0)
     assert s["ru_max"] == pytest.approx(max(0.0, (c["u"] / p0).max()), abs=0.05)
     assert len(s["G_secant_MPa"]) == 1
+    assert s["liquefied"] is False and s["liquefied_at_amplitude"] is None
+    assert s["ru_max_per_amplitude"] == pytest.approx([(c["u"] / p0).max()], rel=1e-8)
+
+
+def test_a_loose_sample_liquefies_and_says_at_which_amplitude(tmp_path):
+    """A loose soft sample (e0 ~ 0.79) cycled undrained: at gamma_a = 1e-3 u builds up a little, at
+    1e-2 sigma_zz falls to zero (ru = u/p0 -> 1). ru per amplitude is the records' largest u/p0 of
+    that amplitude, `liquefied` and the first amplitude that reached test.ru_limit follow from it,
+    and a warning says that G/Gmax there is not a modulus curve."""
+    c, s = run_css(tmp_path / "l", 'test.drainage="undrained"', "test.shear_strain_amplitudes=[1e-3, 1e-2]",
+                   "test.cycles_per_amplitude=2", "sample.prep_friction_deg=30", "test.probe_strain=0")
+    p0, limit = s["confining_pressure"], 0.95  # test.ru_limit's default
+    per = [(c["u"][c["amplitude"] == k + 1] / p0).max() for k in range(2)]
+    assert s["ru_max_per_amplitude"] == pytest.approx(per, rel=1e-8)  # the CSV's digits
+    assert per[0] < limit <= per[1]
+    assert s["liquefied"] is True
+    assert s["liquefied_at_amplitude"] == pytest.approx(s["shear_strain_amplitudes"][1])
+    # ru is u/p0 of sigma_zz: at most 1 but for the constraint's round-off (a few Pa of tension).
+    assert limit <= s["ru_max"] <= 1 + 1e-4
+    assert s["G_over_Gmax"][1] < 0.3
+    assert any("liquefied" in w and "gamma_a = 0.01" in w for w in s["warnings"])
 
 
 def test_kill_and_resume_is_bit_identical(tmp_path):

@@ -239,7 +239,7 @@ SUMMARY_ONLY_SOMETIMES = {
     "n_cycles_to_liquefaction", "ru_max", "cycles", "double_amplitude_strain_max", "csr", "liquefaction_criterion",
     # cyclic simple shear
     "shear_strain_amplitudes", "G_secant_MPa", "G_over_Gmax", "damping_ratio", "Gmax_MPa", "cycles_per_amplitude",
-    "G_method",
+    "G_method", "ru_max_per_amplitude", "liquefied_at_amplitude",
     # stress path
     "path_points", "path_source", "path_completed", "path_s_reached", "path_stress_deviation_max", "path_method",
 }
