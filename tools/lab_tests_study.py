@@ -148,13 +148,18 @@ def cu_report(done, group, title, png, table):
     write_table(table, lines)
 
 
+def ru_at(d, s, k):
+    """The largest recorded ru = u/p0 while amplitude k was cycled (the `amplitude` column is k + 1)."""
+    return max(u for u, a in zip(d["u"], d["amplitude"]) if a == k + 1) / s["confining_pressure"]
+
+
 def css_report(done, group, title, png, table):
     """The G/Gmax and damping table and plot of one cyclic simple shear group."""
     per_amp = {}
     undrained = group.startswith("ucss")
     lines = ["| seed | e0 | Gmax [MPa] | E0/(2(1+ν0)) [MPa] | G/Gmax at γa | ξ [%] at γa | "
-             + ("σzz max [kPa] | σzz end [kPa] | volume drift max | " if undrained else "") + "wall [s] |",
-             "|---:|---:|---:|---:|---|---|" + ("---:|---:|---:|" if undrained else "") + "---:|"]
+             + ("ru max at γa | σzz max [kPa] | σzz end [kPa] | volume drift max | " if undrained else "") + "wall [s] |",
+             "|---:|---:|---:|---:|---|---|" + ("---|---:|---:|---:|" if undrained else "") + "---:|"]
     fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
     for name, (g, preset, s, d) in sorted(done.items()):
         if g != group:
@@ -166,7 +171,8 @@ def css_report(done, group, title, png, table):
         lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['Gmax_MPa'])} | {fmt(gp)} | "
                      + ", ".join(f"{r:.3f} @ {am:.0e}" for am, r in zip(amps, ratio)) + " | "
                      + ", ".join(f"{100 * x:.2f}" for x in xi) + " | "
-                 + (f"{max(d['sigma1']) / 1e3:.0f} | {d['sigma1'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
+                 + (", ".join(f"{ru_at(d, s, k):.3f}" for k in range(len(amps))) + " | "
+                    f"{max(d['sigma1']) / 1e3:.0f} | {d['sigma1'][-1] / 1e3:.0f} | {s['volume_drift_max']:.1e} | "
                     if undrained else "") + f"{s['wall_seconds']:.0f} |")
         axg.semilogx(amps, ratio, "o-", lw=0.9, label=f"seed {s['seed']}")
         axd.semilogx(amps, [100 * x for x in xi], "s-", lw=0.9, label=f"seed {s['seed']}")
@@ -275,7 +281,7 @@ def report(a):
         lines = ["| CSR | seed | e0 | N to liquefaction | ru max | DA strain max [%] | cycles run | volume drift max | wall [s] |",
                  "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         fig = plt.figure(figsize=(5.5, 4.2))
-        for name, (g, preset, s, d) in sorted(done.items()):
+        for name, (g, preset, s, d) in sorted(done.items(), key=lambda kv: (kv[1][2]["csr"], kv[1][2]["seed"])):
             if g != "cyclic":
                 continue
             n = s["n_cycles_to_liquefaction"]
@@ -286,25 +292,46 @@ def report(a):
                 plt.semilogx([n], [s["csr"]], "o", color="tab:red")
             else:
                 plt.semilogx([s["cycles"]], [s["csr"]], ">", color="tab:grey")
-        plt.xlabel("cycles to liquefaction N (grey ▶: not liquefied in the cycles run)")
-        plt.ylabel("CSR = q_cyc / (2 p0)")
-        plt.grid(alpha=0.3, which="both")
-        plt.title("Undrained cyclic triaxial, loose, p0 = 200 kPa", fontsize=10)
-        plt.tight_layout()
-        plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
-        plt.close()
         # Per CSR over the seeds: N of each seed (a run that did not liquefy counts as "> cycles run").
         lines += ["", "| CSR | seeds | liquefied | N per seed | N median |", "|---:|---:|---:|---|---:|"]
         by_csr = {}
         for name, (g, preset, s, d) in sorted(done.items()):
             if g == "cyclic":
                 by_csr.setdefault(s["csr"], []).append(s)
+        medians = []
         for csr in sorted(by_csr):
             v = sorted(by_csr[csr], key=lambda s: s["seed"])
             ns = [s["n_cycles_to_liquefaction"] for s in v]
             shown = [fmt(n) if n is not None else f"> {s['cycles']:g}" for n, s in zip(ns, v)]
-            median = statistics.median(ns) if all(n is not None for n in ns) else None
-            lines.append(f"| {csr:g} | {len(v)} | {sum(n is not None for n in ns)} | {', '.join(shown)} | {fmt(median)} |")
+            # A run that did not liquefy is censored: N > cycles run. The median is still known when
+            # the middle value(s) of the sorted Ns are not censored (censored ones sort last).
+            ordered = sorted(math.inf if n is None else n for n in ns)
+            mid = ordered[(len(ordered) - 1) // 2: len(ordered) // 2 + 1]
+            median = statistics.mean(mid) if all(math.isfinite(x) for x in mid) else None
+            if median is not None:
+                medians.append((csr, median))
+            shown_median = fmt(median) if median is not None else "> " + f"{min(s['cycles'] for s in v):g}"
+            lines.append(f"| {csr:g} | {len(v)} | {sum(n is not None for n in ns)} | {', '.join(shown)} | {shown_median} |")
+            if median is not None:
+                plt.semilogx([median], [csr], "_", ms=18, mew=2, color="black")
+        # CSR = a N^-b through the medians (least squares in log-log): the exponent a laboratory
+        # campaign reports (clean sands: b ~ 0.2-0.35).
+        if len(medians) >= 3:
+            x = [math.log(n) for _, n in medians]
+            y = [math.log(c) for c, _ in medians]
+            mx, my = statistics.mean(x), statistics.mean(y)
+            b = -sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sum((xi - mx) ** 2 for xi in x)
+            lines += ["", f"CSR = a·N^(−b) through the {len(medians)} medians (least squares in log–log): b = {b:.2f}"]
+            plt.semilogx([n for _, n in medians], [c for c, _ in medians], "-", color="black", lw=0.8,
+                         label=f"median over the seeds (b = {b:.2f})")
+            plt.legend(fontsize=8)
+        plt.xlabel("cycles to liquefaction N (▶ grey: not liquefied; bar: median)", fontsize=9)
+        plt.ylabel("CSR = q_cyc / (2 p0)")
+        plt.grid(alpha=0.3, which="both")
+        plt.title("Undrained cyclic triaxial, loose (e0 ≈ 0.65), p0 = 200 kPa, 3 seeds", fontsize=10)
+        plt.tight_layout()
+        plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
+        plt.close()
         write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
     # Dense undrained with cavitation (test.back_pressure).
     if "cav" in a.only:
