@@ -295,6 +295,7 @@ void reportMonotonic(const RunConfig& config, const ShearResult& shear, Laborato
     s["E50_MPa"] = nullptr;
     s["E50_method"] = "not measured (simple shear)";
     s["final_shear_strain"] = records.back().gamma;
+    s["gamma0"] = lab.protocol()->state.gamma0;
   } else {
     s["E50_MPa"] = m.e50 ? Json(finite(*m.e50 / 1e6, "E50_MPa")) : Json(nullptr);
     s["E50_method"] = m.e50 ? "secant from the start of shearing to q = q_peak/2 (q_peak the largest deviator "
@@ -422,6 +423,7 @@ void reportReversing(const RunConfig& config, const ShearResult& shear, Laborato
     s["G_over_Gmax"] = ratio;
     s["damping_ratio"] = damping;
     s["Gmax_MPa"] = n > 0 ? Json(gmax / 1e6) : Json(nullptr);
+    s["gamma0"] = ps.gamma0;
     s["cycles_per_amplitude"] = config.test.cyclesPerAmplitude;
     s["G_method"] = fmt::format(
         "per amplitude, over its last of {} cycles: G = (tau_max - tau_min)/(gamma_max - gamma_min) (secant), "

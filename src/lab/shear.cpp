@@ -63,7 +63,7 @@ Record Laboratory::measure(const Vec3* meanStress, double meanShearStress) const
   if (sim_.boundary == Boundary::Periodic) {
     r.eps1Log = -std::log(len[2] / h0);
     r.stressSkew = 0.5 * (sc - sc.transpose()).norm() / std::max(std::abs(sc.trace() / 3.0), 1e-300);
-    r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
+    r.gamma = sim_.cell.h(0, 2) / sim_.cell.h(2, 2) - (protocol_ ? protocol_->state.gamma0 : 0.0);
     r.tau = meanStress ? meanShearStress : -0.5 * (sc(0, 2) + sc(2, 0));
     if (info(t.type).strain == DrivingStrain::Shear) r.phiDeg = radToDeg(std::atan2(r.tau, r.sigma1));
   }
@@ -134,6 +134,9 @@ void Laboratory::beginShear() {
   st.h0 = b.referenceLengths()[2];
   st.v0 = b.referenceVolume();
   st.l0 = b.referenceLengths();
+  // A prepared cell is slightly skewed (its servo relaxed the shear stresses by shearing it: gamma
+  // of a few 1e-3 to 2e-2); gamma is measured from here, as a laboratory measures shear strain.
+  if (sim_.boundary == Boundary::Periodic) protocol_->state.gamma0 = sim_.cell.h(0, 2) / sim_.cell.h(2, 2);
   protocol_->configure(b);
   // Walls: platens at constant speed, the engineering axial strain rate on the initial height. Cell:
   // the same engineering rate of H_zz (or the shear rate). The rate is ramped up linearly over

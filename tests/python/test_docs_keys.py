@@ -222,7 +222,7 @@ def test_timeseries_columns_are_documented_in_order(short_run):
 
 SUMMARY_ONLY_SOMETIMES = {
     "mu_r_mean", "mu_r_min", "mu_r_max",   # rolling-linear runs
-    "G_MPa", "final_shear_strain",         # simple shear
+    "G_MPa", "final_shear_strain", "gamma0",  # simple shear
     "growth_curve",                        # ellipsoid shape growth
     "deposition",                          # sample.method = "deposition"
     "under_compaction",                    # sample.method = "under-compaction"

@@ -31,8 +31,7 @@ class CyclicSimpleShear final : public SimpleShearBase {
   static constexpr double kPi = 3.14159265358979323846;
 
   void configure(BoundaryControl& b) override {
-    configureNormal(b);
-    state.gamma0 = gammaOf(b);
+    configureNormal(b);  // state.gamma0: the cell's skew at the start (Laboratory, shear.cpp)
     state.lastGamma = 0.0;
     state.lastTau = tauOf(b);
     state.direction = 1;
@@ -103,7 +102,7 @@ class CyclicSimpleShear final : public SimpleShearBase {
   }
   void recorded(const Record& r) override {
     state.recordDue = false;
-    state.lastRecorded = r.gamma - state.gamma0;
+    state.lastRecorded = r.gamma;  // measured from gamma0
   }
   static constexpr double kRecordFraction = 0.1;
   double autoRateFactor() const override { return kCyclicShearRateFactor; }
