@@ -6,7 +6,7 @@ oedometer, cyclic triaxial at several CSRs, cyclic simple shear drained and undr
 (docs/results/lab-tests.md).
 
     /usr/bin/python3 tools/lab_tests_study.py run    [--runs runs/lab-tests] [--exe build/grainlab] [--jobs 2]
-                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w]
+                                                     [--seeds 1,2,3] [--only cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w,cu-w-cav]
     /usr/bin/python3 tools/lab_tests_study.py report [--runs runs/lab-tests] [--seeds 1,2,3]
                                                      [--out docs/results/lab-tests.md]
 
@@ -73,6 +73,8 @@ def cases(seeds, only):
             yield "ucss-loose", "csl-loose", f"ucss-loose_s{seed}", CSS + ['test.drainage="undrained"'] + s
         if "cu-w" in only:
             yield "cu-w", "w-base", f"cu-w_s{seed}", CU + ["output.vtk_every_strain=0"] + s
+        if "cu-w-cav" in only:
+            yield "cu-w-cav", "w-base", f"cu-w-bp300_s{seed}", CAV + ["output.vtk_every_strain=0"] + s
 
 
 def run(a):
@@ -212,6 +214,9 @@ def report(a):
     if "cu" in a.only:
         cu_report(done, "cu", "Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)",
                   os.path.join(out_dir, "undrained.png"), os.path.join(out_dir, "undrained-table.md"))
+    if "cu-w-cav" in a.only:
+        cu_report(done, "cu-w-cav", "Undrained triaxial, w-base, p0 = 100 kPa, back pressure 300 kPa (cavitation at u = −399 kPa)",
+                  os.path.join(out_dir, "undrained-w-cav.png"), os.path.join(out_dir, "undrained-w-cav-table.md"))
     if "cu-w" in a.only:
         cu_report(done, "cu-w", "Undrained triaxial, the [W] law's base sample (w-base, e0 = 0.60), p0 = 100 kPa",
                   os.path.join(out_dir, "undrained-w.png"), os.path.join(out_dir, "undrained-w-table.md"))
@@ -375,7 +380,8 @@ def report(a):
     files = {"cu": ("undrained-table.md", "undrained.png"), "cu-slow": ("undrained-rate-table.md", "undrained-rate.png"), "oedometer": ("oedometer-table.md", "oedometer.png"),
              "cyclic": ("cyclic-table.md", "csr-n.png"), "css": ("css-table.md", "css.png"),
              "ucss": ("ucss-table.md", "ucss.png"), "cav": ("cavitation-table.md", "cavitation.png"),
-             "ucss-loose": ("ucss-loose-table.md", "ucss-loose.png"), "cu-w": ("undrained-w-table.md", "undrained-w.png")}
+             "ucss-loose": ("ucss-loose-table.md", "ucss-loose.png"), "cu-w": ("undrained-w-table.md", "undrained-w.png"),
+             "cu-w-cav": ("undrained-w-cav-table.md", "undrained-w-cav.png")}
     # Only the groups asked for (--only): a report of some campaigns leaves the others' files alone.
     ran = {g for g, _, _, _ in done.values()}
     for g, names in files.items():
@@ -394,7 +400,7 @@ def main():
     ap.add_argument("--exe", default="build/grainlab")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seeds", default="1,2,3")
-    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w")
+    ap.add_argument("--only", default="cu,cu-slow,oedometer,cyclic,css,ucss,cav,ucss-loose,cu-w,cu-w-cav")
     ap.add_argument("--out", default="docs/results/lab-tests.md")
     a = ap.parse_args()
     a.seeds = [int(s) for s in a.seeds.split(",")]
