@@ -17,7 +17,9 @@ frictional unloading, ouadfel-frictionless/ for [O]'s).
 --seeds 2,3 runs the whole series again for those sample seeds (sample.seed: the lattice's jitter),
 each into OUT/seed<N>/ (seed 1 is OUT itself); with --doc, seeds.md there gives, per shape and
 pressure, the mean and sample standard deviation over seed 1 and these, and the least-squares
-slope of phi_p against log10 p of each seed (the trend with pressure a referee asks about).
+slope of phi_p against log10 p of each seed (the trend with pressure a referee asks about), and
+each seed's grown sample (e0, Z0, phi_p at 100 kPa). --drop spheres:3 leaves a shape's seed out of
+the means (say why on the results page: e.g. a lattice that did not collapse and stayed a crystal).
 """
 import statistics
 import argparse
@@ -88,15 +90,25 @@ def document_seeds(args, seeds, pictures):
             return f"{v[0]:.{digits}f}"
         return f"{statistics.mean(v):.{digits}f} ± {statistics.stdev(v):.{digits}f}"
 
-    lines = [f"Seeds {', '.join(map(str, seeds))}: mean ± sample standard deviation.", "",
+    dropped = {tuple(d.split(":")) for d in args.drop}
+    kept = {shape: [seed for seed in seeds if (shape, str(seed)) not in dropped] for shape in SHAPES}
+    lines = ["Each seed's sample at 100 kPa (after growth and re-equilibration):", "",
+             "| grains | seed | e0 | Z0 | φp [°] | in the means |", "|---|---:|---:|---:|---:|---|"]
+    for shape in SHAPES:
+        for seed in seeds:
+            _, s = load(os.path.join(seed_dir(args, seed), f"{shape}-100kPa"))
+            lines.append(f"| {shape} | {seed} | {s['e0']:.3f} | {s['isotropic_state']['coordination']:.2f} | "
+                         f"{s['phi_peak_deg']:.1f} | {'yes' if seed in kept[shape] else 'no (--drop)'} |")
+    lines += ["", f"Mean ± sample standard deviation over the seeds kept "
+              f"({'; '.join(f'{sh}: ' + ', '.join(map(str, kept[sh])) for sh in SHAPES)}).", "",
              "| grains | p [kPa] | κ | e0 | Z0 | φp [°] | ε1 at peak [%] | φ at 20.5 % [°] | ψmax [°] | εv at 20.5 % [%] |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     slopes = {}
     for shape in SHAPES:
-        per_seed = {seed: [] for seed in seeds}
+        per_seed = {seed: [] for seed in kept[shape]}
         for p in PRESSURES_KPA:
             vals = {k: [] for k in ("e0", "Z0", "phi", "epk", "phiend", "psi", "ev")}
-            for seed in seeds:
+            for seed in kept[shape]:
                 rows, s = load(os.path.join(seed_dir(args, seed), f"{shape}-{p}kPa"))
                 last = rows[-1]
                 vals["e0"].append(s["e0"])
@@ -110,13 +122,14 @@ def document_seeds(args, seeds, pictures):
             lines.append(f"| {shape} | {p} | {KN / (p * 1e3 * DIAMETER):.0f} | {ms(vals['e0'], 3)} | {ms(vals['Z0'], 2)} | "
                          f"{ms(vals['phi'], 1)} | {ms(vals['epk'], 1)} | {ms(vals['phiend'], 1)} | {ms(vals['psi'], 1)} | "
                          f"{ms(vals['ev'], 2)} |")
-        slopes[shape] = [slope([x for x, _ in per_seed[seed]], [y for _, y in per_seed[seed]]) for seed in seeds]
+        slopes[shape] = {seed: slope([x for x, _ in per_seed[seed]], [y for _, y in per_seed[seed]]) for seed in kept[shape]}
     lines += ["", "Slope of φp against log10 p (degrees per decade of p, 10 → 100 kPa), per seed:", "",
               "| grains | " + " | ".join(f"seed {seed}" for seed in seeds) + " | mean ± std |",
               "|---|" + "---:|" * (len(seeds) + 1)]
     for shape in SHAPES:
         v = slopes[shape]
-        lines.append(f"| {shape} | " + " | ".join(f"{x:+.2f}" for x in v) + f" | {ms(v, 2)} |")
+        lines.append(f"| {shape} | " + " | ".join(f"{v[seed]:+.2f}" if seed in v else "—" for seed in seeds)
+                     + f" | {ms(list(v.values()), 2)} |")
     with open(os.path.join(pictures, "seeds.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -209,6 +222,8 @@ def main():
                     help="how the 100 kPa packing goes to the lower pressures ([O]: frictionless)")
     ap.add_argument("--doc", help="write results/ouadfel tables and plots into this folder")
     ap.add_argument("--seeds", default="", help="further sample seeds (e.g. 2,3), each into OUT/seed<N>")
+    ap.add_argument("--drop", action="append", default=[], metavar="SHAPE:SEED",
+                    help="leave this shape's seed out of seeds.md's means (it is still listed)")
     args = ap.parse_args()
     args.grainlab = os.path.abspath(args.grainlab)
     seeds = [1] + [int(x) for x in args.seeds.split(",") if x.strip() and int(x) != 1]
