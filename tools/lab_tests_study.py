@@ -155,6 +155,37 @@ def ru_at(d, s, k):
     return max(u for u, a in zip(d["u"], d["amplitude"]) if a == k + 1) / s["confining_pressure"]
 
 
+def cav_report(done, group, title, png, table):
+    """The table and the q-p' / eps_v plot of one undrained group with cavitation (test.back_pressure)."""
+    lines = ["| seed | e0 | u_cav [kPa] | ε1 at cavitation [%] | u min [kPa] | q peak [kPa] | ε1 at peak [%] | "
+             "φ peak [°] | p′ end [kPa] | q end [kPa] | εv end [%] | volume drift max (undrained part) | wall [s] |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    fig, (ax, axv) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for name, (g, preset, s, d) in sorted(done.items()):
+        if g != group:
+            continue
+        ce = s["cavitation_strain"]
+        lines.append(f"| {s['seed']} | {s['e0']:.3f} | {s['cavitation_pressure'] / 1e3:.1f} | "
+                     f"{fmt(100 * ce if ce is not None else None)} | {s['u_min'] / 1e3:.1f} | "
+                     f"{s['q_peak'] / 1e3:.0f} | {100 * s['eps1_at_peak']:.1f} | {s['phi_peak_deg']:.1f} | "
+                     f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {100 * d['eps_v'][-1]:.1f} | "
+                     f"{s['volume_drift_max']:.1e} | {s['wall_seconds']:.0f} |")
+        ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], lw=0.9, label=f"seed {s['seed']}")
+        axv.plot([100 * e for e in d["eps1"]], [100 * v for v in d["eps_v"]], lw=0.9, label=f"seed {s['seed']}")
+    ax.set_xlabel("p′ [kPa]")
+    ax.set_ylabel("q [kPa]")
+    axv.set_xlabel("axial strain ε1 [%]")
+    axv.set_ylabel("εv [%] (compression positive)")
+    for x in (ax, axv):
+        x.grid(alpha=0.3)
+        x.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    write_table(table, lines)
+
+
 def css_report(done, group, title, png, table):
     """The G/Gmax and damping table and plot of one cyclic simple shear group."""
     per_amp = {}
@@ -215,8 +246,9 @@ def report(a):
         cu_report(done, "cu", "Undrained triaxial, calibrated Karlsruhe sand, p0 = 200 kPa (red loose, blue dense)",
                   os.path.join(out_dir, "undrained.png"), os.path.join(out_dir, "undrained-table.md"))
     if "cu-w-cav" in a.only:
-        cu_report(done, "cu-w-cav", "Undrained triaxial, w-base, p0 = 100 kPa, back pressure 300 kPa (cavitation at u = −399 kPa)",
-                  os.path.join(out_dir, "undrained-w-cav.png"), os.path.join(out_dir, "undrained-w-cav-table.md"))
+        cav_report(done, "cu-w-cav", "Undrained triaxial, [W] set (w-base), p0 = 100 kPa, back pressure 300 kPa "
+                   "(cavitation at u = −399 kPa)",
+                   os.path.join(out_dir, "undrained-w-cav.png"), os.path.join(out_dir, "undrained-w-cav-table.md"))
     if "cu-w" in a.only:
         cu_report(done, "cu-w", "Undrained triaxial, the [W] law's base sample (w-base, e0 = 0.60), p0 = 100 kPa",
                   os.path.join(out_dir, "undrained-w.png"), os.path.join(out_dir, "undrained-w-table.md"))
@@ -338,36 +370,10 @@ def report(a):
         plt.savefig(os.path.join(out_dir, "csr-n.png"), dpi=110)
         plt.close()
         write_table(os.path.join(out_dir, "cyclic-table.md"), lines)
-    # Dense undrained with cavitation (test.back_pressure).
+    # Undrained with cavitation (test.back_pressure): the dense calibrated sand, and the [W] set.
     if "cav" in a.only:
-        lines = ["| seed | e0 | u_cav [kPa] | ε1 at cavitation [%] | u min [kPa] | q peak [kPa] | ε1 at peak [%] | "
-                 "φ peak [°] | p′ end [kPa] | q end [kPa] | εv end [%] | volume drift max (undrained part) | wall [s] |",
-                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-        fig, (ax, axv) = plt.subplots(1, 2, figsize=(11, 4.2))
-        for name, (g, preset, s, d) in sorted(done.items()):
-            if g != "cav":
-                continue
-            ce = s["cavitation_strain"]
-            lines.append(f"| {s['seed']} | {s['e0']:.3f} | {s['cavitation_pressure'] / 1e3:.1f} | "
-                         f"{fmt(100 * ce if ce is not None else None)} | {s['u_min'] / 1e3:.1f} | "
-                         f"{s['q_peak'] / 1e3:.0f} | {100 * s['eps1_at_peak']:.1f} | {s['phi_peak_deg']:.1f} | "
-                         f"{d['p'][-1] / 1e3:.0f} | {d['q'][-1] / 1e3:.0f} | {100 * d['eps_v'][-1]:.1f} | "
-                         f"{s['volume_drift_max']:.1e} | {s['wall_seconds']:.0f} |")
-            ax.plot([p / 1e3 for p in d["p"]], [q / 1e3 for q in d["q"]], lw=0.9, label=f"seed {s['seed']}")
-            axv.plot([100 * e for e in d["eps1"]], [100 * v for v in d["eps_v"]], lw=0.9, label=f"seed {s['seed']}")
-        ax.set_xlabel("p′ [kPa]")
-        ax.set_ylabel("q [kPa]")
-        axv.set_xlabel("axial strain ε1 [%]")
-        axv.set_ylabel("εv [%] (compression positive)")
-        for x in (ax, axv):
-            x.grid(alpha=0.3)
-            x.legend(fontsize=8)
-        fig.suptitle("Undrained triaxial, dense, p0 = 200 kPa, back pressure 300 kPa (cavitation at u = −399 kPa)",
-                     fontsize=10)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out_dir, "cavitation.png"), dpi=110)
-        plt.close(fig)
-        write_table(os.path.join(out_dir, "cavitation-table.md"), lines)
+        cav_report(done, "cav", "Undrained triaxial, dense, p0 = 200 kPa, back pressure 300 kPa (cavitation at u = −399 kPa)",
+                   os.path.join(out_dir, "cavitation.png"), os.path.join(out_dir, "cavitation-table.md"))
     # Cyclic simple shear, drained and undrained.
     for group, title, png, table in (("css", "Drained cyclic simple shear, dense, σzz = 200 kPa", "css.png", "css-table.md"),
                                      ("ucss", "Undrained (constant-volume) cyclic simple shear, dense, p0 = 200 kPa",
