@@ -2,6 +2,7 @@
 """Drained triaxial test in a periodic cell, side by side in grainlab and YADE on the same packing.
 
 Usage: compare_periodic.py [--particles 1000] [--strain 0.08] [--rate 1.0] [--out DIR] [--doc FILE]
+                           [--seeds 1,2,3] [--jobs 2]
 
 grainlab prepares the sample (preset periodic-triaxial: the [W] grading 2-8 mm, e0 = 0.60 searched,
 100 kPa) and writes its packing; both programs then start from that packing, re-equilibrate it with
@@ -9,7 +10,15 @@ their own servo and shear it at the same axial strain rate with the lateral stre
 100 kPa. grainlab runs with contact.moment_limit = "yade" (bending and twisting each capped at
 eta min(R1, R2) |Fn|, as YADE's CohFrictPhys does), so that the laws are the same and what differs
 is the engines. Writes both time series, an overlay plot and (with --doc) a Markdown section.
+
+--seeds 1,2,3 prepares one sample per seed (sample.seed) into OUT/seed<N>/ and runs both codes on
+each (--jobs seeds at a time, one thread each); the Markdown then gives, per code, the mean and
+sample standard deviation over the seeds of phi and eps_v at each strain and of the peak phi up to
+--peak-until, and the difference of the means beside the larger of the two scatters (agreement
+is claimed only where the difference is within it).
 Needs `yade` on PATH. Child processes get argument vectors, never a shell."""
+import statistics
+from concurrent.futures import ThreadPoolExecutor
 import argparse
 import csv
 import json
@@ -45,6 +54,73 @@ def at(series, e):
     return None
 
 
+STRAINS = (0.001, 0.0025, 0.005, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08)
+
+
+def one(a, out, seed):
+    """Prepares the sample of `seed` and shears it in both codes into `out` (or reuses it there):
+    (grainlab series, YADE series, grainlab summary, grainlab shear wall time, YADE wall time)."""
+    os.makedirs(out, exist_ok=True)
+    prep = os.path.join(out, "prepared")
+    common = ["--set", f"sample.n_particles={a.particles}", "--threads", str(a.threads), "--quiet", *LAW]
+    packing = os.path.join(prep, "packing.txt")
+    gl = os.path.join(out, "grainlab")
+    yade_csv = os.path.join(out, "yade.csv")
+    if a.reuse:
+        tg = json.load(open(os.path.join(gl, "summary.json")))["wall_seconds"]
+        ty = float(open(yade_csv + ".time").read())
+    else:
+        run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", prep, "--set", 'test.type="isotropic"',
+             "--set", "output.plots=false", "--set", f"sample.seed={seed}", *common])
+        tg = run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", gl, "--set", f'sample.packing="{packing}"',
+                  "--set", f"test.axial_strain_rate={a.rate}", "--set", f"test.final_axial_strain={a.strain}",
+                  "--set", "output.plots=false", "--set", "output.vtk_every_strain=0", *common])
+        ty = run(["yade", "-n", "-x", os.path.join(HERE, "yade_periodic.py"), packing, yade_csv,
+                  "--strain", str(a.strain), "--rate", str(a.rate)])
+        with open(yade_csv + ".time", "w") as f:
+            f.write(f"{ty}\n")
+    summary = json.load(open(os.path.join(gl, "summary.json")))
+    return read(os.path.join(gl, "timeseries.csv")), read(yade_csv), summary, tg, ty
+
+
+def seeds_table(a, results):
+    """Mean +- sample std over the seeds, per code, and the difference against the scatter."""
+    def ms(v):
+        return f"{statistics.mean(v):.2f} ± {statistics.stdev(v):.2f}" if len(v) > 1 else f"{v[0]:.2f}"
+
+    lines = [f"Seeds {', '.join(str(s) for s in results)}: e0 "
+             + ", ".join(f"{r[2]['e0']:.3f}" for r in results.values()) + ".", "",
+             "| eps1 | phi grainlab [°] | phi YADE [°] | difference [°] | within scatter | "
+             "eps_v grainlab [%] | eps_v YADE [%] | difference [%] | within scatter |",
+             "|---:|---:|---:|---:|---|---:|---:|---:|---|"]
+
+    def row(label, g, y):
+        d = statistics.mean(g) - statistics.mean(y)
+        sc = max(statistics.stdev(g), statistics.stdev(y)) if len(g) > 1 else 0.0
+        return label, ms(g), ms(y), f"{d:+.2f}", "yes" if abs(d) <= sc else "no"
+
+    for e in STRAINS:
+        if e > a.strain + 1e-12:
+            break
+        pts = [(at(r[0], e), at(r[1], e)) for r in results.values()]
+        if not all(pg and py for pg, py in pts):
+            continue
+        _, gphi, yphi, dphi, okphi = row("", [pg[1] for pg, _ in pts], [py[1] for _, py in pts])
+        _, gv, yv, dv, okv = row("", [100 * pg[0] for pg, _ in pts], [100 * py[0] for _, py in pts])
+        lines.append(f"| {100 * e:.2g} % | {gphi} | {yphi} | {dphi} | {okphi} | {gv} | {yv} | {dv} | {okv} |")
+    until = a.peak_until
+    peak = lambda s: max((r for r in s if r[0] <= until), key=lambda r: r[2])
+    pk = [(peak(r[0]), peak(r[1])) for r in results.values()]
+    _, gp, yp, dp, okp = row("", [g[2] for g, _ in pk], [y[2] for _, y in pk])
+    _, ge, ye, de, oke = row("", [100 * g[0] for g, _ in pk], [100 * y[0] for _, y in pk])
+    lines += ["", f"Peak φ up to ε1 = {100 * until:g} %: grainlab {gp}°, YADE {yp}°, difference {dp}° "
+              f"(within the larger scatter: {okp}); at ε1 grainlab {ge} %, YADE {ye} %.", "",
+              "Shear wall times, one thread each, two runs at a time: grainlab "
+              + ", ".join(f"{r[3]:.0f}" for r in results.values()) + " s; YADE "
+              + ", ".join(f"{r[4]:.0f}" for r in results.values()) + " s."]
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--particles", type=int, default=1000)
@@ -56,29 +132,22 @@ def main():
     ap.add_argument("--reuse", action="store_true",
                     help="keep the runs already in --out (prepared/, grainlab/, yade.csv) and only compare; the "
                          "wall times are then those the runs recorded (grainlab's summary, YADE's yade.time)")
+    ap.add_argument("--seeds", help="e.g. 1,2,3: one sample per seed into OUT/seed<N>, and the statistics")
+    ap.add_argument("--jobs", type=int, default=1, help="with --seeds: seeds run at a time")
+    ap.add_argument("--peak-until", type=float, default=0.045,
+                    help="with --seeds: the peak phi is the largest up to this axial strain")
     a = ap.parse_args()
-    os.makedirs(a.out, exist_ok=True)
-    prep = os.path.join(a.out, "prepared")
-    common = ["--set", f"sample.n_particles={a.particles}", "--threads", str(a.threads), "--quiet", *LAW]
-    packing = os.path.join(prep, "packing.txt")
-    gl = os.path.join(a.out, "grainlab")
-    yade_csv = os.path.join(a.out, "yade.csv")
-    if a.reuse:
-        tg = json.load(open(os.path.join(gl, "summary.json")))["wall_seconds"]
-        ty = float(open(yade_csv + ".time").read())
-    else:
-        run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", prep, "--set", 'test.type="isotropic"',
-             "--set", "output.plots=false", *common])
-        tg = run([GRAINLAB, "run", "preset:periodic-triaxial", "--out", gl, "--set", f'sample.packing="{packing}"',
-                  "--set", f"test.axial_strain_rate={a.rate}", "--set", f"test.final_axial_strain={a.strain}",
-                  "--set", "output.plots=false", "--set", "output.vtk_every_strain=0", *common])
-        ty = run(["yade", "-n", "-x", os.path.join(HERE, "yade_periodic.py"), packing, yade_csv,
-                  "--strain", str(a.strain), "--rate", str(a.rate)])
-        with open(yade_csv + ".time", "w") as f:
-            f.write(f"{ty}\n")
-    g = read(os.path.join(gl, "timeseries.csv"))
-    y = read(yade_csv)
-    summary = json.load(open(os.path.join(gl, "summary.json")))
+    if a.seeds:
+        seeds = [int(x) for x in a.seeds.split(",")]
+        with ThreadPoolExecutor(a.jobs) as pool:
+            res = list(pool.map(lambda sd: one(a, os.path.join(a.out, f"seed{sd}"), sd), seeds))
+        table = seeds_table(a, dict(zip(seeds, res)))
+        print(table)
+        if a.doc:
+            with open(a.doc, "w") as f:
+                f.write(table + "\n")
+        return 0
+    g, y, summary, tg, ty = one(a, a.out, 1)
 
     import matplotlib
     matplotlib.use("Agg")
@@ -98,7 +167,7 @@ def main():
     fig.savefig(png, dpi=110)
 
     lines = ["| eps1 | phi grainlab | phi YADE | eps_v grainlab | eps_v YADE |", "|---:|---:|---:|---:|---:|"]
-    for e in (0.001, 0.0025, 0.005, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08):
+    for e in STRAINS:
         if e > a.strain:
             break
         pg, py = at(g, e), at(y, e)
