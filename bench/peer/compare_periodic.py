@@ -121,6 +121,31 @@ def seeds_table(a, results):
     return "\n".join(lines)
 
 
+def seeds_plot(a, results, png):
+    """phi and eps_v against eps1 of every seed, both codes (solid grainlab, dashed YADE)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    for k, (seed, r) in enumerate(results.items()):
+        for series, style, code in ((r[0], "-", "grainlab"), (r[1], "--", "YADE")):
+            ax[0].plot([100 * x[0] for x in series], [x[2] for x in series], style, color=f"C{k}", lw=0.9,
+                       label=f"{code}, seed {seed}")
+            ax[1].plot([100 * x[0] for x in series], [100 * x[1] for x in series], style, color=f"C{k}", lw=0.9)
+    ax[0].set_xlabel("eps1 [%]")
+    ax[0].set_ylabel("mobilised friction angle phi [deg]")
+    ax[1].set_xlabel("eps1 [%]")
+    ax[1].set_ylabel("eps_v [%] (contraction +)")
+    ax[0].legend(fontsize=7)
+    for x in ax:
+        x.grid(alpha=0.3)
+    fig.suptitle(f"periodic cell, {a.particles} spheres, p = 100 kPa, same packing and law per seed "
+                 "(solid grainlab, dashed YADE 2023.02a)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--particles", type=int, default=1000)
@@ -142,6 +167,7 @@ def main():
         with ThreadPoolExecutor(a.jobs) as pool:
             res = list(pool.map(lambda sd: one(a, os.path.join(a.out, f"seed{sd}"), sd), seeds))
         table = seeds_table(a, dict(zip(seeds, res)))
+        seeds_plot(a, dict(zip(seeds, res)), os.path.join(a.out, "compare_periodic_seeds.png"))
         print(table)
         if a.doc:
             with open(a.doc, "w") as f:
