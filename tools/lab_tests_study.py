@@ -109,15 +109,18 @@ def mean_sd(values):
     return f"{statistics.mean(v):.3g} ± {statistics.stdev(v):.2g} ({len(v)} seeds)"
 
 
+def runs_of(done, group):
+    """(preset, summary, series) of each completed run of one group, in the order of their names."""
+    return [(preset, s, d) for name, (g, preset, s, d) in sorted(done.items()) if g == group]
+
+
 def cu_report(done, group, title, png, table):
     """The table and the q-p' / u-eps1 plot of one undrained triaxial group."""
     lines = ["| sample | seed | e0 | p′ min [kPa] | u max [kPa] | q at PT [kPa] | ε1 at PT [%] | liquefied | "
              "p′ end [kPa] | q end [kPa] | φ mobilised end [°] | volume drift max | wall [s] |",
              "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
     fig, (ax, axu) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != group:
-            continue
+    for preset, s, d in runs_of(done, group):
         pt_q, pt_e = s.get("q_at_phase_transformation"), s.get("eps1_at_phase_transformation")
         sample = preset.split("-")[1]
         p_end, q_end = d["p"][-1], d["q"][-1]
@@ -161,9 +164,7 @@ def cav_report(done, group, title, png, table):
              "φ peak [°] | p′ end [kPa] | q end [kPa] | εv end [%] | volume drift max (undrained part) | wall [s] |",
              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     fig, (ax, axv) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != group:
-            continue
+    for preset, s, d in runs_of(done, group):
         ce = s["cavitation_strain"]
         lines.append(f"| {s['seed']} | {s['e0']:.3f} | {s['cavitation_pressure'] / 1e3:.1f} | "
                      f"{fmt(100 * ce if ce is not None else None)} | {s['u_min'] / 1e3:.1f} | "
@@ -194,9 +195,7 @@ def css_report(done, group, title, png, table):
              + ("ru max at γa | σzz max [kPa] | σzz end [kPa] | volume drift max | " if undrained else "") + "wall [s] |",
              "|---:|---:|---:|---:|---|---|" + ("---|---:|---:|---:|" if undrained else "") + "---:|"]
     fig, (axg, axd) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, (g, preset, s, d) in sorted(done.items()):
-        if g != group:
-            continue
+    for preset, s, d in runs_of(done, group):
         amps, ratio, xi = s["shear_strain_amplitudes"], s["G_over_Gmax"], s["damping_ratio"]
         for k, (am, r, x) in enumerate(zip(amps, ratio, xi)):
             per_amp.setdefault(k, []).append((am, r, x))
@@ -295,9 +294,7 @@ def report(a):
     if "oedometer" in a.only:
         lines = ["| seed | e0 | K0 | K0 unloading | Cc | Cs | σv max [kPa] | wall [s] |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
         k0s, fig = [], plt.figure(figsize=(5.5, 4.2))
-        for name, (g, preset, s, d) in sorted(done.items()):
-            if g != "oedometer":
-                continue
+        for preset, s, d in runs_of(done, "oedometer"):
             k0s.append(s["K0"])
             lines.append(f"| {s['seed']} | {s['e0']:.3f} | {fmt(s['K0'])} | {fmt(s['K0_unloading'])} | {fmt(s['Cc'])} | "
                          f"{fmt(s['Cs'])} | {s['sigma_v_max'] / 1e3:.0f} | {s['wall_seconds']:.0f} |")
@@ -318,9 +315,8 @@ def report(a):
         lines = ["| CSR | seed | e0 | N to liquefaction | ru max | DA strain max [%] | cycles run | volume drift max | wall [s] |",
                  "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         fig = plt.figure(figsize=(5.5, 4.2))
-        for name, (g, preset, s, d) in sorted(done.items(), key=lambda kv: (kv[1][2]["csr"], kv[1][2]["seed"])):
-            if g != "cyclic":
-                continue
+        cyclic = sorted(runs_of(done, "cyclic"), key=lambda r: (r[1]["csr"], r[1]["seed"]))
+        for preset, s, d in cyclic:
             n = s["n_cycles_to_liquefaction"]
             lines.append(f"| {s['csr']:g} | {s['seed']} | {s['e0']:.3f} | {fmt(n)} | {fmt(s['ru_max'])} | "
                          f"{100 * s['double_amplitude_strain_max']:.2f} | {s['cycles']:g} | {s['volume_drift_max']:.1e} | "
@@ -332,9 +328,8 @@ def report(a):
         # Per CSR over the seeds: N of each seed (a run that did not liquefy counts as "> cycles run").
         lines += ["", "| CSR | seeds | liquefied | N per seed | N median |", "|---:|---:|---:|---|---:|"]
         by_csr = {}
-        for name, (g, preset, s, d) in sorted(done.items()):
-            if g == "cyclic":
-                by_csr.setdefault(s["csr"], []).append(s)
+        for preset, s, d in cyclic:
+            by_csr.setdefault(s["csr"], []).append(s)
         medians = []
         for csr in sorted(by_csr):
             v = sorted(by_csr[csr], key=lambda s: s["seed"])
