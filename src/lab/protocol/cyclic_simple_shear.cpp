@@ -51,7 +51,7 @@ class CyclicSimpleShear final : public SimpleShearBase {
     b.imposeShearRate(std::min(rate, slowest), factor * state.direction);
   }
   void afterStep(const BoundaryControl& b) override {
-    const double gamma = gammaOf(b) - state.gamma0;
+    const double gamma = strain(b);
     const double tau = tauOf(b);
     state.path += std::abs(gamma - state.lastGamma);
     state.loopArea += 0.5 * (tau + state.lastTau) * (gamma - state.lastGamma);
@@ -106,7 +106,6 @@ class CyclicSimpleShear final : public SimpleShearBase {
   }
   static constexpr double kRecordFraction = 0.1;
   double autoRateFactor() const override { return kCyclicShearRateFactor; }
-  double strain(const BoundaryControl& b) const override { return gammaOf(b) - state.gamma0; }
   double progress(const BoundaryControl&) const override { return state.path; }
   bool finished(const BoundaryControl&) const override { return state.done; }
   double fractionDone(const BoundaryControl&) const override {

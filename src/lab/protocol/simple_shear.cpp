@@ -16,8 +16,6 @@ class SimpleShear final : public SimpleShearBase {
     if (undrained()) updateDrainage(b);
     b.imposeShearRate(rate, factor);
   }
-  // gamma since the start of the test: the prepared cell's skew gamma0 is not shear the test imposed.
-  double strain(const BoundaryControl& b) const override { return gammaOf(b) - state.gamma0; }
   bool finished(const BoundaryControl& b) const override { return strain(b) >= config_.test.finalShearStrain; }
   double fractionDone(const BoundaryControl& b) const override {
     return std::min(1.0, strain(b) / config_.test.finalShearStrain);

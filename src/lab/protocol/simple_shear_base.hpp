@@ -18,6 +18,8 @@ class SimpleShearBase : public ShearProtocol {
   void completeRecord(Record& r) const override {
     if (undrained()) r.u = config_.test.confiningPressure - r.sigma1;
   }
+  // gamma since the start of the test: the prepared cell's skew gamma0 is not shear the test imposed.
+  double strain(const BoundaryControl& b) const override { return gammaOf(b) - state.gamma0; }
 
  protected:
   // The normal controls at the start of the test (the shear rate is the protocol's).
